@@ -1,0 +1,30 @@
+# fdml_localization: the two commands.
+#   make test   install what is missing, build in a private catkin workspace, run every test
+#   make demo   install, build, and run the headless kidnapped-robot demo (RVIZ=1 opens rviz)
+# Other targets: make deps | build | bench | clean
+SHELL := /bin/bash
+WS ?= $(CURDIR)/ws
+RVIZ ?= 0
+export WS
+
+.PHONY: all deps build test demo bench clean
+
+all: build
+
+deps:
+	@bash scripts/install_deps.sh
+
+build: deps
+	@bash scripts/build.sh
+
+test: deps
+	@bash scripts/run_tests.sh
+
+demo: build
+	@RVIZ=$(RVIZ) bash scripts/demo.sh
+
+bench: build
+	@bash scripts/bench.sh
+
+clean:
+	rm -rf $(WS)

@@ -18,8 +18,9 @@ namespace
 {
 namespace core = fdml_localization::core;
 
-/// Relative radius noise of the --random polygon: radii uniform in [0.5, 1.5] x mean radius.
-constexpr double kRandomRadiusNoise = 0.5;
+/// Relative radius noise of the --random polygon: radii uniform in [0.65, 1.35] x mean radius,
+/// the standard deviation (0.2) of the public prototype's Gaussian radii.
+constexpr double kRandomRadiusNoise = 0.35;
 
 const char* kUsage =
     "usage: fdml_bench --map PATH[:SCALE] [--map ...] [--random VERTICES[:SCALE]]\n"

@@ -50,7 +50,9 @@ int sparsityKPrime(const BenchConfig& config);
  * @brief The localizer options for one method and resolution. With range noise sigma the
  *        preimage band is max(0.02, 3 sigma) and the agreement tolerance max(0.05, 4 sigma).
  *        k' is min_inliers for robust (0 = automatic), min_inliers or the paper's 6 for paper,
- *        and k for the baseline.
+ *        and k for the baseline. Paper and baseline use the public prototype's settings: every
+ *        candidate is returned, the paper method's agreement tolerance is its 2 m and the
+ *        baseline has no agreement filter (1e9 m).
  */
 LocalizerOptions benchLocalizerOptions(const BenchConfig& config, Method method, int n);
 

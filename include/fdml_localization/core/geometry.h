@@ -116,6 +116,10 @@ bool segmentsIntersect(const Segment& s, const Segment& t);
 /// Squared distance from point p to a segment [m^2].
 double pointSegmentDistanceSquared(const Vec2& p, const Segment& seg);
 
+/// True when the horizontal half-line from p towards +x crosses the edge a-b (half-open in y,
+/// so a vertex on the line is counted once). Symmetric in a and b.
+bool crossesRightOf(const Vec2& p, const Vec2& a, const Vec2& b);
+
 /// Crossing-number point-in-ring test (points exactly on the boundary may go either way).
 bool pointInRing(const Vec2& p, const Ring& ring);
 

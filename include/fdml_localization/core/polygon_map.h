@@ -6,6 +6,7 @@
 
 #include "fdml_localization/core/geometry.h"
 
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -89,8 +90,12 @@ private:
   double area_ = 0.0;
 };
 
-/// Removes consecutive duplicate vertices (within 1e-12 m) and a closing vertex equal to the first.
-Ring cleanRing(const Ring& ring);
+/**
+ * @brief Removes consecutive duplicate vertices (closer than 1e-12 m) and a closing vertex
+ *        equal to the first.
+ * @param kept when not null, receives for each vertex of the result its index in @p ring
+ */
+Ring cleanRing(const Ring& ring, std::vector<std::size_t>* kept = nullptr);
 
 }  // namespace core
 }  // namespace fdml_localization

@@ -243,27 +243,31 @@ def office():
 
 
 def warehouse():
-    r = Raster(30.0, 20.0)
-    r.free((0, 1.0, 30, 20))
-    r.free((4.0, 0, 7.0, 1.0), (10.0, 0, 13.0, 1.0), (16.5, 0, 19.0, 1.0))  # loading bays
-    # office in the north-west corner
-    r.wall(*door_gaps_v(6.0, 6.15, 14.0, 20.0, [(16.0, 1.0)]))
-    r.wall(*door_gaps_h(14.0, 14.15, 0, 6.0, [(2.0, 1.0)]))
-    # shelf rows (1 m deep) in columns, a few missing, lengths varying
-    columns = [(1.5, 5.5), (8.0, 11.5), (12.0, 15.0), (17.0, 20.5), (21.0, 23.5), (25.0, 28.5)]
-    rows = [3.0, 6.3, 9.6, 12.9, 16.2]
-    missing = {(0, 3), (2, 1), (4, 4), (0, 4), (5, 0)}
+    r = Raster(48.0, 31.0)
+    r.free((0, 1.0, 48, 31))
+    r.free((5.0, 0, 8.5, 1.0), (12.0, 0, 15.5, 1.0), (19.0, 0, 22.5, 1.0), (33.0, 0, 36.5, 1.0))  # loading bays
+    # office in the north-west corner, a partition in the north-east
+    r.wall(*door_gaps_v(8.0, 8.15, 25.0, 31.0, [(27.0, 1.0)]))
+    r.wall(*door_gaps_h(25.0, 25.15, 0, 8.0, [(2.5, 1.0)]))
+    r.wall(*door_gaps_h(26.0, 26.1, 38.0, 48.0, [(41.0, 2.5)]))
+    # racks 1.2 m deep in 6 rows with 2.6 m aisles; 11 columns with 1 m cross-aisles;
+    # lengths vary and some racks are missing, so no two places look alike
+    rows = [2.5, 6.3, 10.1, 13.9, 17.7, 21.5]
+    missing = {(0, 5), (3, 2), (4, 4), (7, 1), (9, 3), (10, 5), (6, 0), (1, 3)}
     for ri, y in enumerate(rows):
-        for ci, (x0, x1) in enumerate(columns):
+        for ci in range(11):
             if (ci, ri) in missing:
                 continue
-            shorten = 0.5 * ((ri * 3 + ci * 5) % 4)
-            r.wall((x0, y, x1 - shorten, y + 1.0))
-    # structural columns in the aisles
-    r.wall((7.0, 5.0, 7.4, 5.4), (16.0, 11.2, 16.4, 11.6), (24.1, 8.0, 24.5, 8.4), (16.0, 4.6, 16.4, 5.0))
+            x0 = 2.0 + 4.2 * ci
+            shorten = 0.3 * ((ri * 5 + ci * 7) % 4)
+            r.wall((x0, y, x0 + 3.2 - shorten, y + 1.2))
+    # structural columns (0.4 m) at aisle crossings, on an irregular pattern
+    for k, (cx, cy) in enumerate([(5.5, 4.9), (13.9, 8.7), (22.3, 4.9), (30.7, 12.5), (39.1, 8.7),
+                                  (9.7, 16.3), (26.5, 20.1), (43.3, 16.3), (18.1, 23.9), (35.0, 23.9)]):
+        r.wall((cx - 0.2, cy - 0.2, cx + 0.2, cy + 0.2))
     return r, (0, 0), (
-        "warehouse: 30 m x 19 m hall (plus three loading bays) with 25 shelf racks in rows,\n"
-        "4 structural columns and an office in the north-west corner.")
+        "warehouse: a 48 m x 30 m hall (plus four loading bays) with 58 racks in 6 rows and\n"
+        "11 columns, 10 structural columns, an office (north-west) and a partition wall (north-east).")
 
 
 def corridor():

@@ -1,16 +1,14 @@
 // The grid ray cast against the brute-force loop over every edge (>= 100,000 rays per map,
-// including rays through vertices and rays parallel to edges), accelerated free-space tests
-// against the brute-force crossing number, and scene casts against a brute-force minimum.
+// including rays through vertices and rays parallel to edges), and accelerated free-space and
+// box queries against brute force. Scene casts are in test_scene.cpp.
 #include "fdml_localization/core/map_generators.h"
 #include "fdml_localization/core/map_io.h"
 #include "fdml_localization/core/ray_caster.h"
-#include "fdml_localization/core/scene.h"
 
 #include "test_util.h"
 
 #include <gtest/gtest.h>
 
-#include <memory>
 #include <random>
 #include <sstream>
 
@@ -42,11 +40,6 @@ std::vector<NamedMap> allMaps()
   options.seed = 5;
   maps.push_back({ "building 60x40", generateBuilding(options) });
   return maps;
-}
-
-Vec2 unitDir(double angle)
-{
-  return Vec2(std::cos(angle), std::sin(angle));
 }
 
 /// Compares grid and brute-force casts, counting disagreements and keeping the first few.
@@ -128,12 +121,12 @@ void checkMapRays(const NamedMap& named, const SegmentGrid& grid, std::uint64_t 
   // 1. Random rays from inside and outside the map.
   for (int i = 0; i < 50000; ++i)
   {
-    checker.check(random_point(), unitDir(angle(rng)));
+    checker.check(random_point(), test::unitDir(angle(rng)));
   }
   // 2. Random rays with a finite range.
   for (int i = 0; i < 10000; ++i)
   {
-    checker.check(random_point(), unitDir(angle(rng)), 3.0 * unit(rng) * b.size().maxCoeff());
+    checker.check(random_point(), test::unitDir(angle(rng)), 3.0 * unit(rng) * b.size().maxCoeff());
   }
   // 3. Axis-aligned rays, some along the lines of vertices (along walls of rectilinear maps).
   const Vec2 axes[4] = { Vec2(1, 0), Vec2(0, 1), Vec2(-1, 0), Vec2(0, -1) };
@@ -160,7 +153,7 @@ void checkMapRays(const NamedMap& named, const SegmentGrid& grid, std::uint64_t 
     {
       checker.check(o, (e.a - o).normalized());
     }
-    checker.check(e.a, unitDir(angle(rng)));
+    checker.check(e.a, test::unitDir(angle(rng)));
   }
   // 5. Rays parallel to edges: on the edge's line (collinear, from before, inside and after the
   //    edge, both ways, starting at its endpoints) and at small and large offsets from it.
@@ -206,7 +199,7 @@ TEST(RayCaster, GridEqualsBruteForceForOtherCellSizes)
     CastChecker checker(grid);
     for (int i = 0; i < 10000; ++i)
     {
-      checker.check(Vec2(ux(rng), uy(rng)), unitDir(angle(rng)));
+      checker.check(Vec2(ux(rng), uy(rng)), test::unitDir(angle(rng)));
     }
     EXPECT_EQ(checker.failures(), 0) << "cell " << cell << ":\n" << checker.report();
   }
@@ -274,7 +267,7 @@ TEST(RayCaster, IsFreeEqualsBruteForce)
       }
       else if (i % 4 == 2)
       {
-        p = e.a + 1e-7 * unitDir(angle(rng));  // next to a vertex
+        p = e.a + 1e-7 * test::unitDir(angle(rng));  // next to a vertex
       }
       bool on_boundary = false;
       for (const Segment& s : edges)
@@ -331,161 +324,6 @@ TEST(RayCaster, BoxQueriesEqualBruteForce)
       ASSERT_EQ(grid.anySegmentInBox(box), !expected.empty());
     }
   }
-}
-
-namespace
-{
-/// Independent ray/disc distance (origin outside the disc): project the centre on the ray.
-double discDistance(const Vec2& o, const Vec2& d, const Vec2& c, double r)
-{
-  const double s = (c - o).dot(d);
-  const double h2 = (c - o).squaredNorm() - s * s;
-  if (h2 > r * r)
-  {
-    return kInf;
-  }
-  const double t = s - std::sqrt(r * r - h2);
-  return t >= 0.0 ? t : kInf;
-}
-
-double polygonDistance(const Vec2& o, const Vec2& d, const Ring& ring)
-{
-  double best = kInf;
-  for (std::size_t i = 0; i < ring.size(); ++i)
-  {
-    best = std::min(best, raySegmentDistance(o, d, Segment{ ring[i], ring[(i + 1) % ring.size()] }));
-  }
-  return best;
-}
-
-std::vector<Obstacle> randomObstacles(const Box2& b, std::mt19937_64& rng)
-{
-  std::uniform_real_distribution<double> ux(b.min.x(), b.max.x()), uy(b.min.y(), b.max.y());
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::vector<Obstacle> obstacles;
-  for (int i = 0; i < 20; ++i)
-  {
-    obstacles.push_back(Obstacle::disc(Vec2(ux(rng), uy(rng)), 0.05 + 0.5 * unit(rng)));
-  }
-  for (int i = 0; i < 8; ++i)
-  {
-    // Star-shaped (possibly non-convex) polygons of 3 to 7 vertices.
-    const Vec2 c(ux(rng), uy(rng));
-    const int n = 3 + i % 5;
-    Ring ring;
-    for (int k = 0; k < n; ++k)
-    {
-      const double a = kTwoPi * (k + 0.8 * unit(rng)) / n;
-      ring.push_back(c + (0.2 + 0.6 * unit(rng)) * unitDir(a));
-    }
-    obstacles.push_back(Obstacle::polygon(ring));
-  }
-  return obstacles;
-}
-
-bool insideAnyObstacle(const Vec2& p, const std::vector<Obstacle>& obstacles)
-{
-  for (const Obstacle& o : obstacles)
-  {
-    const bool inside = o.shape == Obstacle::Shape::Disc ? (p - o.centre).norm() <= o.radius
-                                                          : pointInRing(p, o.vertices);
-    if (inside)
-    {
-      return true;
-    }
-  }
-  return false;
-}
-}  // namespace
-
-TEST(Scene, CastEqualsBruteForceMinimum)
-{
-  for (const char* name : { "office.poly", "apartment.poly", "warehouse.poly" })
-  {
-    SCOPED_TRACE(name);
-    auto caster =
-        std::make_shared<const MapRayCaster>(loadPolyFile(std::string(FDML_SOURCE_DIR) + "/maps/" + name));
-    Scene scene(caster);
-    std::mt19937_64 rng(61);
-    const Box2& b = caster->map().bounds();
-    const std::vector<Obstacle> obstacles = randomObstacles(b, rng);
-    scene.setObstacles(obstacles);
-    std::uniform_real_distribution<double> ux(b.min.x(), b.max.x()), uy(b.min.y(), b.max.y());
-    std::uniform_real_distribution<double> angle(-kPi, kPi), unit(0.0, 1.0);
-    int casts = 0, obstacle_hits = 0, out_of_range = 0;
-    while (casts < 20000)
-    {
-      const Vec2 p(ux(rng), uy(rng));
-      if (!caster->isFree(p) || insideAnyObstacle(p, obstacles))
-      {
-        continue;
-      }
-      ++casts;
-      const Pose2 sensor(p.x(), p.y(), angle(rng));
-      const double max_range = casts % 3 == 0 ? 4.0 * unit(rng) : kInf;
-      const Vec2 d = sensor.heading();
-      const double map_distance = caster->grid().castBruteForce(p, d).distance;
-      double expected = map_distance;
-      int expected_obstacle = -1;
-      for (std::size_t i = 0; i < obstacles.size(); ++i)
-      {
-        const Obstacle& o = obstacles[i];
-        const double t = o.shape == Obstacle::Shape::Disc ? discDistance(p, d, o.centre, o.radius)
-                                                           : polygonDistance(p, d, o.vertices);
-        if (t < expected)
-        {
-          expected = t;
-          expected_obstacle = static_cast<int>(i);
-        }
-      }
-      const SceneHit hit = scene.cast(sensor, max_range);
-      if (expected > max_range)
-      {
-        ++out_of_range;
-        ASSERT_EQ(hit.kind, SceneHit::Kind::None) << "cast " << casts;
-        continue;
-      }
-      ASSERT_NEAR(hit.distance, expected, 1e-9) << "cast " << casts;
-      if (expected_obstacle >= 0)
-      {
-        ++obstacle_hits;
-        ASSERT_EQ(hit.kind, SceneHit::Kind::Obstacle) << "cast " << casts;
-        ASSERT_EQ(hit.obstacle, expected_obstacle) << "cast " << casts;
-      }
-      else
-      {
-        ASSERT_EQ(hit.kind, SceneHit::Kind::Map) << "cast " << casts;
-      }
-      if (std::isinf(max_range))
-      {
-        ASSERT_NEAR(hit.map_distance, map_distance, 1e-9) << "cast " << casts;
-      }
-    }
-    EXPECT_GT(obstacle_hits, 200);
-    EXPECT_GT(out_of_range, 100);
-  }
-}
-
-TEST(Scene, IsFreeExcludesObstacles)
-{
-  auto caster =
-      std::make_shared<const MapRayCaster>(loadPolyFile(std::string(FDML_SOURCE_DIR) + "/maps/office.poly"));
-  Scene scene(caster);
-  std::mt19937_64 rng(71);
-  const Box2& b = caster->map().bounds();
-  const std::vector<Obstacle> obstacles = randomObstacles(b, rng);
-  scene.setObstacles(obstacles);
-  std::uniform_real_distribution<double> ux(b.min.x() - 1, b.max.x() + 1), uy(b.min.y() - 1, b.max.y() + 1);
-  int blocked = 0;
-  for (int i = 0; i < 20000; ++i)
-  {
-    const Vec2 p(ux(rng), uy(rng));
-    const bool expected = caster->map().containsBruteForce(p) && !insideAnyObstacle(p, obstacles);
-    blocked += (caster->map().containsBruteForce(p) && !expected) ? 1 : 0;
-    ASSERT_EQ(scene.isFree(p), expected) << p.transpose();
-  }
-  EXPECT_GT(blocked, 50);
-  EXPECT_THROW(Scene(nullptr), std::invalid_argument);
 }
 
 }  // namespace core

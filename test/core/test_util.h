@@ -32,6 +32,12 @@ inline std::vector<std::string> bundledMaps()
   return paths;
 }
 
+/// The unit vector at @p angle [rad].
+inline Vec2 unitDir(double angle)
+{
+  return Vec2(std::cos(angle), std::sin(angle));
+}
+
 /// The file name without directory, for test messages.
 inline std::string baseName(const std::string& path)
 {

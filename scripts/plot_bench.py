@@ -2,8 +2,10 @@
 """Plots fdml_bench CSV output: success (paper, strict, top-1) and median time per
 localization against the resolution n, one PNG per (scene, m), one colour per method.
 
-usage: plot_bench.py BENCH.csv [BENCH2.csv ...] [--out-dir docs] [--prefix bench]
-Writes OUT_DIR/PREFIX_<scene>_m<m>.png and prints the paths. Needs only python3-matplotlib.
+usage: plot_bench.py BENCH.csv [BENCH2.csv ...] [--out-dir docs] [--prefix bench] [--summary]
+Writes OUT_DIR/PREFIX_<scene>_m<m>.png and prints the paths. With --summary it prints instead
+the paper-style Markdown table (success pooled over n, per method and scene x m) of all the
+CSV files together. Needs only python3-matplotlib.
 """
 import argparse
 import csv
@@ -39,12 +41,49 @@ def read_rows(paths):
     return rows
 
 
+def print_summary(rows):
+    columns, methods = [], []
+    pools = defaultdict(lambda: [0, 0, 0, 0, 0.0, 0.0])  # trials, paper, strict, top1, cand, held
+    for r in rows:
+        col = (r["scene"], int(r["m"]))
+        if col not in columns:
+            columns.append(col)
+        if r["method"] not in methods:
+            methods.append(r["method"])
+        p = pools[(r["method"], col)]
+        p[0] += 1
+        p[1] += int(r["success_paper"])
+        p[2] += int(r["success_strict"])
+        p[3] += int(r["success_top1"])
+        p[4] += int(r["candidates"])
+        p[5] += int(r["sparsity_held"])
+    print("| method | metric | " + " | ".join("%s m=%d" % c for c in columns) + " |")
+    print("|---|---|" + "---:|" * len(columns))
+    metrics = [("success %", 1), ("strict %", 2), ("top-1 %", 3), ("candidates", 4), ("sparsity held %", 5)]
+    for method in methods:
+        for name, i in metrics:
+            cells = []
+            for c in columns:
+                p = pools.get((method, c))
+                if not p or p[0] == 0:
+                    cells.append("-")
+                elif i == 4:
+                    cells.append("%.2f" % (p[4] / p[0]))
+                else:
+                    cells.append("%.1f" % (100.0 * p[i] / p[0]))
+            print("| %s | %s | %s |" % (method, name, " | ".join(cells)))
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("csv", nargs="+")
     parser.add_argument("--out-dir", default="docs")
     parser.add_argument("--prefix", default="bench")
+    parser.add_argument("--summary", action="store_true", help="print the pooled Markdown table, no plots")
     args = parser.parse_args()
+    if args.summary:
+        print_summary(read_rows(args.csv))
+        return
 
     # (scene, m) -> method -> n -> list of rows
     cells = defaultdict(lambda: defaultdict(lambda: defaultdict(list)))

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <fstream>
 #include <iostream>
@@ -180,24 +181,38 @@ Cli parseArgs(int argc, char** argv)
       std::exit(0);
     }
     else if (flag == "--map")
+    {
       cli.maps.push_back(value());
+    }
     else if (flag == "--random")
+    {
       cli.randoms.push_back(value());
+    }
     else if (flag == "--obstacles")
+    {
       c.obstacles = parseIntList(value(), flag);
+    }
     else if (flag == "--radius")
+    {
       c.protocol.obstacle_radius = parseNumber(value(), flag);
+    }
     else if (flag == "--k")
+    {
       c.protocol.readings = parseInt(value(), flag);
+    }
     else if (flag == "--min-inliers")
     {
       const std::string v = value();
       c.min_inliers = v == "auto" ? 0 : parseInt(v, flag);
     }
     else if (flag == "--resolution")
+    {
       c.resolutions = parseIntList(value(), flag);
+    }
     else if (flag == "--trials")
+    {
       c.trials = parseInt(value(), flag);
+    }
     else if (flag == "--seed")
     {
       const int seed = parseInt(value(), flag);
@@ -234,19 +249,33 @@ Cli parseArgs(int argc, char** argv)
       }
     }
     else if (flag == "--threads")
+    {
       c.threads = parseInt(value(), flag);
+    }
     else if (flag == "--moving-obstacles")
+    {
       c.protocol.moving_obstacles = true;
+    }
     else if (flag == "--translate")
+    {
       c.protocol.translate = true;
+    }
     else if (flag == "--noise")
+    {
       c.protocol.noise = parseNumber(value(), flag);
+    }
     else if (flag == "--csv")
+    {
       cli.csv = value();
+    }
     else if (flag == "--markdown")
+    {
       cli.markdown = value();
+    }
     else
+    {
       throw UsageError("unknown option '" + flag + "'");
+    }
   }
   if (c.methods.empty())
   {

@@ -321,3 +321,27 @@ TEST(BenchTool, RejectsBadArguments)
   EXPECT_EQ(runTool("--random 70:-2 --trials 1"), 2);
   EXPECT_EQ(runTool("--trials 1"), 2);
 }
+
+TEST(BenchRunner, LocalizerOptionsPerMethod)
+{
+  core::BenchConfig config;
+  config.scenes.push_back({ "l_room", lRoom() });
+  config.protocol.noise = 0.03;
+  config.min_inliers = 0;
+  EXPECT_TRUE(core::validate(config).empty());
+  EXPECT_EQ(core::sparsityKPrime(config), 6);
+  const core::LocalizerOptions robust = core::benchLocalizerOptions(config, core::Method::Robust, 64);
+  EXPECT_EQ(robust.min_inliers, 0);
+  EXPECT_EQ(robust.resolution, 64);
+  EXPECT_NEAR(robust.range_tolerance, 0.09, 1e-12);
+  EXPECT_NEAR(robust.agreement_tolerance, 0.12, 1e-12);
+  EXPECT_EQ(core::benchLocalizerOptions(config, core::Method::Paper, 64).min_inliers, 6);
+  EXPECT_EQ(core::benchLocalizerOptions(config, core::Method::Baseline, 64).min_inliers, 10);
+  config.min_inliers = 7;
+  EXPECT_EQ(core::sparsityKPrime(config), 7);
+  EXPECT_EQ(core::benchLocalizerOptions(config, core::Method::Paper, 64).min_inliers, 7);
+  EXPECT_TRUE(core::validate(core::benchLocalizerOptions(config, core::Method::Baseline, 64)).empty());
+  config.resolutions = { 8 };
+  config.min_inliers = 2;
+  EXPECT_EQ(core::validate(config).size(), 2u);
+}

@@ -38,12 +38,13 @@ bool segmentFree(const MapRayCaster& map, const Vec2& a, const Vec2& b)
   return !blocked;
 }
 
-/// A disc may sit at @p centre: inside free space and off every sensor position it must avoid.
+/// A disc may sit at @p centre: inside free space, and its centre farther than 2 radii from every
+/// sensor position it must avoid (the public prototype's rule: the disc keeps a gap of one radius).
 bool discAllowed(const MapRayCaster& map, const Vec2& centre, double radius, const std::vector<Vec2>& avoid)
 {
   for (const Vec2& p : avoid)
   {
-    if ((p - centre).norm() <= radius)
+    if ((p - centre).norm() <= 2.0 * radius)
     {
       return false;
     }

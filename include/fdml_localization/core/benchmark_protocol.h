@@ -54,7 +54,8 @@ std::uint64_t trialSeed(std::uint64_t seed, const std::string& scene, int m, int
 
 /**
  * @brief Draws one trial: a random pose in free space; m discs fully inside free space (centre
- *        free, no map edge within the radius) and never containing a sensor position; k readings
+ *        free, no map edge within the radius) whose centres are farther than 2 radii from every
+ *        sensor position (the public prototype's rule, so a disc never covers the sensor); k readings
  *        with 2 pi / k rotation between them (plus a random collision-free step with translate;
  *        obstacles take a random step in free space between readings with moving_obstacles).
  * @throws std::invalid_argument for invalid options, std::runtime_error when the map has no

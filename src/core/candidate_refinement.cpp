@@ -1,0 +1,453 @@
+#include "fdml_localization/core/candidate_refinement.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace fdml_localization
+{
+namespace core
+{
+namespace
+{
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+/// Residual [m] charged to a ray that leaves free space or misses, during the polish.
+constexpr double kPenaltyResidual = 1.0;
+
+/// One reading's residual and its derivative with respect to (x, y, theta).
+struct ResidualRow
+{
+  double r = 0.0;
+  Eigen::RowVector3d jacobian = Eigen::RowVector3d::Zero();
+  bool valid = false;
+};
+
+ResidualRow residualRow(const MapRayCaster& map, const Pose2& q, const Reading& reading)
+{
+  ResidualRow row;
+  const Pose2 sensor = compose(q, reading.offset);
+  const Vec2 origin = sensor.position();
+  if (!map.isFree(origin))
+  {
+    return row;
+  }
+  const Vec2 u = sensor.heading();
+  const RayHit hit = map.cast(origin, u);
+  if (!hit.hit() || !std::isfinite(hit.distance))
+  {
+    return row;
+  }
+  row.valid = true;
+  row.r = hit.distance - reading.range;
+  const Segment& seg = map.grid().segments()[static_cast<std::size_t>(hit.segment)];
+  const Vec2 edge = seg.b - seg.a;
+  const double len = edge.norm();
+  if (len <= 0.0)
+  {
+    return row;
+  }
+  const Vec2 n(-edge.y() / len, edge.x() / len);
+  const double nu = n.dot(u);
+  if (std::abs(nu) < 1e-6)
+  {
+    return row;
+  }
+  // t = (c - n.p) / (n.u): dt/dp = -n / (n.u), dt/dphi = -t (n.u_perp) / (n.u).
+  const double c = std::cos(q.theta);
+  const double s = std::sin(q.theta);
+  const Vec2 dp_dtheta(-s * reading.offset.x - c * reading.offset.y, c * reading.offset.x - s * reading.offset.y);
+  const Vec2 u_perp(-u.y(), u.x());
+  row.jacobian(0) = -n.x() / nu;
+  row.jacobian(1) = -n.y() / nu;
+  row.jacobian(2) = -n.dot(dp_dtheta) / nu - hit.distance * n.dot(u_perp) / nu;
+  return row;
+}
+
+struct System
+{
+  double cost = 0.0;
+  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d g = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
+  double sum_sq = 0.0;
+  int used = 0;
+};
+
+System buildSystem(const MapRayCaster& map, const Pose2& q, const std::vector<Reading>& readings,
+                   const std::vector<bool>& use, double scale)
+{
+  System sys;
+  for (std::size_t i = 0; i < readings.size(); ++i)
+  {
+    if (!use[i] || !std::isfinite(readings[i].range))
+    {
+      continue;
+    }
+    const ResidualRow row = residualRow(map, q, readings[i]);
+    ++sys.used;
+    if (!row.valid)
+    {
+      const double p = kPenaltyResidual;
+      sys.cost += scale > 0.0 ? scale * scale * std::log1p((p / scale) * (p / scale)) : p * p;
+      continue;
+    }
+    double w = 1.0;
+    if (scale > 0.0)
+    {
+      const double z = (row.r / scale) * (row.r / scale);
+      sys.cost += scale * scale * std::log1p(z);
+      w = 1.0 / (1.0 + z);
+    }
+    else
+    {
+      sys.cost += row.r * row.r;
+    }
+    sys.h += w * row.jacobian.transpose() * row.jacobian;
+    sys.g += w * row.jacobian.transpose() * row.r;
+    sys.jtj += row.jacobian.transpose() * row.jacobian;
+    sys.sum_sq += row.r * row.r;
+  }
+  return sys;
+}
+
+Pose2 step(const Pose2& q, const Eigen::Vector3d& delta)
+{
+  return Pose2(q.x + delta(0), q.y + delta(1), wrapAngle(q.theta + delta(2)));
+}
+
+bool evaluationBetter(const PoseEvaluation& a, const PoseEvaluation& b)
+{
+  return a.inliers != b.inliers ? a.inliers > b.inliers : a.rms < b.rms;
+}
+}  // namespace
+
+std::vector<double> vertexMargins(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings,
+                                  double angle_error)
+{
+  std::vector<double> margins(readings.size(), kInf);
+  for (std::size_t i = 0; i < readings.size(); ++i)
+  {
+    const Pose2 sensor = compose(pose, readings[i].offset);
+    const Vec2 origin = sensor.position();
+    if (!std::isfinite(readings[i].range) || !map.isFree(origin))
+    {
+      continue;
+    }
+    const Vec2 u = sensor.heading();
+    const double reach = std::min(map.range(sensor), readings[i].range) + 0.5;
+    for (const Ring& ring : map.map().rings())
+    {
+      for (const Vec2& v : ring)
+      {
+        const Vec2 rel = v - origin;
+        const double t = rel.dot(u);
+        if (t < 0.0 || t > reach)
+        {
+          continue;
+        }
+        const double perp = std::abs(u.x() * rel.y() - u.y() * rel.x());
+        margins[i] = std::min(margins[i], perp - t * angle_error);
+      }
+    }
+  }
+  return margins;
+}
+
+PoseEvaluation evaluatePose(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings,
+                            double eps)
+{
+  PoseEvaluation eval;
+  eval.inlier_mask.assign(readings.size(), false);
+  eval.residuals.assign(readings.size(), kNaN);
+  double sum_sq = 0.0;
+  int finite_inliers = 0;
+  for (std::size_t i = 0; i < readings.size(); ++i)
+  {
+    const Reading& reading = readings[i];
+    const Pose2 sensor = compose(pose, reading.offset);
+    if (!map.isFree(sensor.position()))
+    {
+      continue;
+    }
+    if (std::isfinite(reading.range))
+    {
+      const double h = map.range(sensor);
+      const double r = h - reading.range;
+      eval.residuals[i] = r;
+      if (std::abs(r) < eps)
+      {
+        eval.inlier_mask[i] = true;
+        ++eval.inliers;
+        sum_sq += r * r;
+        ++finite_inliers;
+      }
+    }
+    else
+    {
+      const double h = map.range(sensor, reading.max_range + 1.0);
+      if (h > reading.max_range - eps)
+      {
+        eval.inlier_mask[i] = true;
+        ++eval.inliers;
+      }
+    }
+  }
+  eval.rms = finite_inliers > 0 ? std::sqrt(sum_sq / finite_inliers) : 0.0;
+  return eval;
+}
+
+PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std::vector<Reading>& readings,
+                         const std::vector<bool>& use, double robust_scale, int max_iterations,
+                         double noise_sigma)
+{
+  PolishOutcome out;
+  out.pose = start;
+  System sys = buildSystem(map, out.pose, readings, use, robust_scale);
+  double lambda = 1e-3;
+  for (int iter = 0; iter < max_iterations; ++iter)
+  {
+    out.iterations = iter + 1;
+    Eigen::Matrix3d a = sys.h;
+    a.diagonal() += lambda * sys.h.diagonal() + Eigen::Vector3d::Constant(1e-12);
+    Eigen::Vector3d delta = -a.ldlt().solve(sys.g);
+    if (!delta.allFinite())
+    {
+      break;
+    }
+    // Keep each step local: the ray-cast model only holds near the current pose.
+    const double max_shift = 0.5;
+    const double max_turn = 0.3;
+    const double shift = delta.head<2>().norm();
+    const double scale = std::max({ 1.0, shift / max_shift, std::abs(delta(2)) / max_turn });
+    delta /= scale;
+    const Pose2 trial = step(out.pose, delta);
+    const System next = buildSystem(map, trial, readings, use, robust_scale);
+    if (next.cost < sys.cost)
+    {
+      out.pose = trial;
+      sys = next;
+      lambda = std::max(lambda / 3.0, 1e-9);
+      if (delta.head<2>().norm() < 1e-8 && std::abs(delta(2)) < 1e-9)
+      {
+        break;
+      }
+    }
+    else
+    {
+      lambda *= 4.0;
+      if (lambda > 1e8)
+      {
+        break;
+      }
+    }
+  }
+  const System final_sys = buildSystem(map, out.pose, readings, use, 0.0);
+  const int dof = final_sys.used - 3;
+  double sigma2 = noise_sigma * noise_sigma;
+  if (dof > 0)
+  {
+    sigma2 = std::max(sigma2, final_sys.sum_sq / dof);
+  }
+  Eigen::FullPivLU<Eigen::Matrix3d> lu(final_sys.jtj);
+  if (lu.rank() == 3)
+  {
+    out.covariance = sigma2 * lu.inverse();
+  }
+  else
+  {
+    out.covariance = Eigen::Matrix3d::Identity() * 1e6;
+  }
+  return out;
+}
+
+Candidate verifiedCandidate(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings,
+                            double eps)
+{
+  const PoseEvaluation eval = evaluatePose(map, pose, readings, eps);
+  Candidate c;
+  c.pose = Pose2(pose.x, pose.y, wrapAngle(pose.theta));
+  c.inlier_mask = eval.inlier_mask;
+  c.inliers = eval.inliers;
+  c.rms_residual = eval.rms;
+  return c;
+}
+
+Candidate refineSeed(const MapRayCaster& map, const Pose2& seed, const std::vector<Reading>& readings,
+                     const std::vector<bool>& hypothesis, const RefinementSettings& settings)
+{
+  const double eps = settings.agreement_tolerance;
+  Pose2 best_pose = seed;
+  PoseEvaluation best = evaluatePose(map, seed, readings, eps);
+  Eigen::Matrix3d best_cov = Eigen::Matrix3d::Identity() * 1e6;
+
+  // Adopts a polished pose when it explains more readings, or as many with a lower RMS.
+  auto consider = [&](const PolishOutcome& polished) {
+    PoseEvaluation eval = evaluatePose(map, polished.pose, readings, eps);
+    if (!evaluationBetter(eval, best))
+    {
+      return false;
+    }
+    best = std::move(eval);
+    best_pose = polished.pose;
+    best_cov = polished.covariance;
+    return true;
+  };
+  auto polishOn = [&](const std::vector<bool>& use, double scale) {
+    return polishPose(map, best_pose, readings, use, scale, settings.max_iterations, settings.noise_sigma);
+  };
+  auto finiteInliers = [&](int drop) {
+    std::vector<bool> use(readings.size(), false);
+    for (std::size_t i = 0; i < readings.size(); ++i)
+    {
+      use[i] = best.inlier_mask[i] && std::isfinite(readings[i].range) && static_cast<int>(i) != drop;
+    }
+    return use;
+  };
+  auto countUsed = [](const std::vector<bool>& use) { return static_cast<int>(std::count(use.begin(), use.end(), true)); };
+  // Re-polishes on the current inliers while that improves the consensus.
+  auto polishRounds = [&]() {
+    for (int round = 0; round < settings.max_rounds; ++round)
+    {
+      const std::vector<bool> use = finiteInliers(-1);
+      if (countUsed(use) < 3)
+      {
+        return;
+      }
+      const std::vector<bool> before = best.inlier_mask;
+      if (!consider(polishOn(use, 0.0)) || best.inlier_mask == before)
+      {
+        return;
+      }
+    }
+  };
+
+  // First polish: robust, on the hypothesis minus the readings whose rays pass a vertex within
+  // the seed's uncertainty (most suspect first), keeping at least 4 readings.
+  {
+    const std::vector<double> margins = vertexMargins(map, seed, readings, settings.seed_angle_error);
+    std::vector<int> used;
+    for (std::size_t i = 0; i < readings.size(); ++i)
+    {
+      if (hypothesis[i] && std::isfinite(readings[i].range))
+      {
+        used.push_back(static_cast<int>(i));
+      }
+    }
+    std::sort(used.begin(), used.end(), [&](int a, int b) { return margins[a] < margins[b]; });
+    std::vector<bool> use = hypothesis;
+    int remaining = static_cast<int>(used.size());
+    for (int i : used)
+    {
+      if (remaining <= 4 || margins[i] >= settings.seed_position_error)
+      {
+        break;
+      }
+      use[i] = false;
+      --remaining;
+    }
+    consider(polishOn(use, settings.robust_scale));
+    if (use != hypothesis)
+    {
+      consider(polishOn(hypothesis, settings.robust_scale));
+    }
+  }
+  polishRounds();
+  // The ray-cast cost is only piecewise smooth: a reading whose ray crosses an occlusion edge
+  // between here and the optimum can hold the polish in a false minimum. Leave out, one at a
+  // time, the readings passing nearest to a vertex and the worst one, and keep the result
+  // when the consensus improves.
+  for (int attempt = 0; attempt < settings.max_escapes && best.rms > 1e-9; ++attempt)
+  {
+    std::vector<int> order;
+    for (std::size_t i = 0; i < readings.size(); ++i)
+    {
+      if (best.inlier_mask[i] && std::isfinite(readings[i].range))
+      {
+        order.push_back(static_cast<int>(i));
+      }
+    }
+    if (order.size() < 4)
+    {
+      break;
+    }
+    const std::vector<double> margins = vertexMargins(map, best_pose, readings, settings.seed_angle_error);
+    std::vector<int> tries;
+    const int worst = *std::max_element(order.begin(), order.end(), [&](int a, int b) {
+      return std::abs(best.residuals[a]) < std::abs(best.residuals[b]);
+    });
+    tries.push_back(worst);
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return margins[a] < margins[b]; });
+    for (int i : order)
+    {
+      if (static_cast<int>(tries.size()) >= settings.escape_tries)
+      {
+        break;
+      }
+      if (i != worst)
+      {
+        tries.push_back(i);
+      }
+    }
+    bool improved = false;
+    for (std::size_t j = 0; j < tries.size() && !improved; ++j)
+    {
+      improved = consider(polishOn(finiteInliers(tries[j]), 0.0));
+    }
+    if (!improved)
+    {
+      break;
+    }
+    polishRounds();
+  }
+  Candidate c;
+  c.pose = Pose2(best_pose.x, best_pose.y, wrapAngle(best_pose.theta));
+  c.inlier_mask = best.inlier_mask;
+  c.inliers = best.inliers;
+  c.rms_residual = best.rms;
+  c.covariance = best_cov;
+  return c;
+}
+
+bool betterCandidate(const Candidate& a, const Candidate& b)
+{
+  if (a.inliers != b.inliers)
+  {
+    return a.inliers > b.inliers;
+  }
+  return a.rms_residual < b.rms_residual;
+}
+
+std::vector<Candidate> rankAndDeduplicate(std::vector<Candidate> candidates, double distance, double angle,
+                                          int max_candidates)
+{
+  std::stable_sort(candidates.begin(), candidates.end(), betterCandidate);
+  std::vector<Candidate> kept;
+  for (Candidate& c : candidates)
+  {
+    if (static_cast<int>(kept.size()) >= max_candidates)
+    {
+      break;
+    }
+    bool duplicate = false;
+    for (const Candidate& k : kept)
+    {
+      const double dd = std::hypot(c.pose.x - k.pose.x, c.pose.y - k.pose.y);
+      if (dd < distance && std::abs(angleDiff(c.pose.theta, k.pose.theta)) < angle)
+      {
+        duplicate = true;
+        break;
+      }
+    }
+    if (!duplicate)
+    {
+      kept.push_back(std::move(c));
+    }
+  }
+  return kept;
+}
+
+}  // namespace core
+}  // namespace fdml_localization

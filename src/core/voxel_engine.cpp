@@ -1,0 +1,355 @@
+#include "fdml_localization/core/voxel_engine.h"
+
+#include "fdml_localization/core/candidate_refinement.h"
+#include "fdml_localization/core/components.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace fdml_localization
+{
+namespace core
+{
+namespace
+{
+double secondsSince(std::chrono::steady_clock::time_point start)
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+/// Seeds (in processing order) that may be retried from other voxels of their plateau.
+constexpr std::size_t kRetriedSeeds = 64;
+
+int floorDiv(double value)
+{
+  return static_cast<int>(std::floor(value));
+}
+}  // namespace
+
+VoxelEngine::VoxelEngine(std::shared_ptr<const MapRayCaster> map, const LocalizerOptions& options)
+  : map_(std::move(map)), options_(options)
+{
+  if (!map_)
+  {
+    throw std::invalid_argument("VoxelEngine: no map");
+  }
+  spec_ = GridSpec::fromMap(map_->map(), options_.resolution, options_.theta_resolution);
+}
+
+int VoxelEngine::threads() const
+{
+  return options_.threads > 0 ? options_.threads : omp_get_max_threads();
+}
+
+void VoxelEngine::prepare()
+{
+  if (prepared_)
+  {
+    return;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  table_ = loadOrBuildTable(*map_, spec_, options_.cache_dir, threads(), &table_source_, &cache_message_);
+  prepared_ = true;
+  prepare_seconds_ = secondsSince(start);
+}
+
+const DistanceTable& VoxelEngine::table()
+{
+  prepare();
+  return table_;
+}
+
+VoxelSet VoxelEngine::rawPreimage(const Reading& reading)
+{
+  prepare();
+  VoxelSet set(spec_);
+  const int nx = spec_.nx;
+  const int ny = spec_.ny;
+  const int nt = spec_.nt;
+  const double dt = spec_.thetaStep();
+  const bool no_return = !std::isfinite(reading.range);
+  const float lo = static_cast<float>(no_return ? reading.max_range - options_.range_tolerance
+                                                : reading.range - options_.range_tolerance);
+  const float hi = static_cast<float>(reading.range + options_.range_tolerance);
+  const std::size_t slice = static_cast<std::size_t>(nx) * ny;
+  const float* bmin = table_.blockMin().data();
+  const float* bmax = table_.blockMax().data();
+#pragma omp parallel for schedule(static) num_threads(threads())
+  for (int it = 0; it < nt; ++it)
+  {
+    const double theta = spec_.centreTheta(it);
+    const double c = std::cos(theta);
+    const double s = std::sin(theta);
+    const double ox = c * reading.offset.x - s * reading.offset.y;
+    const double oy = s * reading.offset.x + c * reading.offset.y;
+    const int sx = floorDiv(ox / spec_.cell);
+    const int sy = floorDiv(oy / spec_.cell);
+    const double phi = wrapAngle(theta + reading.offset.theta);
+    int t0 = floorDiv((phi + kPi) / dt - 0.5) % nt;
+    t0 = t0 < 0 ? t0 + nt : t0;
+    // Blocks start at sample xx in [0, nx - 2] and yy in [0, ny - 2].
+    const int x_begin = std::max(0, -sx);
+    const int x_end = std::min(nx, nx - 1 - sx);
+    const int y_begin = std::max(0, -sy);
+    const int y_end = std::min(ny, ny - 1 - sy);
+    for (int iy = y_begin; iy < y_end; ++iy)
+    {
+      const std::size_t base = static_cast<std::size_t>(t0) * slice + static_cast<std::size_t>(iy + sy) * nx + sx;
+      const float* rmin = bmin + base;
+      const float* rmax = bmax + base;
+      std::uint64_t* row = set.row(iy, it);
+      for (int ix = x_begin; ix < x_end; ++ix)
+      {
+        const bool in = no_return ? rmax[ix] >= lo : (rmin[ix] <= hi && rmax[ix] >= lo);
+        row[ix >> 6] |= static_cast<std::uint64_t>(in) << (ix & 63);
+      }
+    }
+  }
+  return set;
+}
+
+std::vector<VoxelSet> VoxelEngine::preimages(const std::vector<Reading>& readings)
+{
+  std::vector<VoxelSet> sets;
+  sets.reserve(readings.size());
+  for (const Reading& reading : readings)
+  {
+    sets.push_back(rawPreimage(reading).dilated());
+  }
+  return sets;
+}
+
+void VoxelEngine::countField(const std::vector<VoxelSet>& sets, std::vector<std::uint8_t>& count) const
+{
+  count.assign(spec_.voxelCount(), 0);
+  const int nx = spec_.nx;
+  const int ny = spec_.ny;
+  const int nt = spec_.nt;
+#pragma omp parallel for schedule(static) num_threads(threads())
+  for (int it = 0; it < nt; ++it)
+  {
+    for (const VoxelSet& set : sets)
+    {
+      for (int iy = 0; iy < ny; ++iy)
+      {
+        const std::uint64_t* row = set.row(iy, it);
+        std::uint8_t* out = count.data() + spec_.index(0, iy, it);
+        for (int k = 0; k < set.wordsPerRow(); ++k)
+        {
+          std::uint64_t w = row[k];
+          while (w)
+          {
+            const int bit = __builtin_ctzll(w);
+            ++out[k * 64 + bit];
+            w &= w - 1;
+          }
+        }
+      }
+    }
+  }
+  (void)nx;
+}
+
+std::vector<bool> VoxelEngine::membership(std::size_t voxel) const
+{
+  int ix = 0;
+  int iy = 0;
+  int it = 0;
+  spec_.unindex(voxel, ix, iy, it);
+  std::vector<bool> in(sets_.size(), false);
+  for (std::size_t i = 0; i < sets_.size(); ++i)
+  {
+    in[i] = sets_[i].test(ix, iy, it);
+  }
+  return in;
+}
+
+Result VoxelEngine::localize(const std::vector<Reading>& readings)
+{
+  const auto start = std::chrono::steady_clock::now();
+  Result result;
+  result.engine = Engine::Voxel;
+  result.method = options_.method;
+  result.readings_used = static_cast<int>(readings.size());
+  prepare();
+  if (!prepare_reported_)
+  {
+    result.times.table = prepare_seconds_;
+    prepare_reported_ = true;
+  }
+
+  auto stage = std::chrono::steady_clock::now();
+  sets_ = preimages(readings);
+  result.times.preimages = secondsSince(stage);
+
+  stage = std::chrono::steady_clock::now();
+  countField(sets_, count_);
+  result.times.count = secondsSince(stage);
+
+  const int k = static_cast<int>(readings.size());
+  switch (options_.method)
+  {
+    case Method::Robust:
+      localizeRobust(readings, result);
+      break;
+    case Method::Paper:
+      localizeComponentCentres(readings, options_.min_inliers, result);
+      break;
+    case Method::Baseline:
+      localizeComponentCentres(readings, k, result);
+      break;
+  }
+  result.times.total = secondsSince(start);
+  return result;
+}
+
+void VoxelEngine::localizeComponentCentres(const std::vector<Reading>& readings, int min_inliers,
+                                           Result& result)
+{
+  result.min_inliers_used = min_inliers;
+  auto stage = std::chrono::steady_clock::now();
+  const std::vector<VoxelCluster> clusters = connectedComponents(spec_, count_, min_inliers);
+  result.times.components = secondsSince(stage);
+
+  stage = std::chrono::steady_clock::now();
+  std::vector<Candidate> candidates(clusters.size());
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads())
+  for (long c = 0; c < static_cast<long>(clusters.size()); ++c)
+  {
+    candidates[c] = verifiedCandidate(*map_, clusters[c].centroid, readings, options_.agreement_tolerance);
+    candidates[c].support = static_cast<double>(clusters[c].voxels.size());
+  }
+  std::vector<Candidate> kept;
+  for (Candidate& c : candidates)
+  {
+    if (c.inliers >= min_inliers)
+    {
+      kept.push_back(std::move(c));
+    }
+  }
+  result.candidates = rankAndDeduplicate(std::move(kept), options_.uniqueness_distance,
+                                         options_.uniqueness_angle, options_.max_candidates);
+  result.times.verification = secondsSince(stage);
+}
+
+void VoxelEngine::localizeRobust(const std::vector<Reading>& readings, Result& result)
+{
+  const int k = static_cast<int>(readings.size());
+  const bool automatic = options_.min_inliers <= 0;
+  const int lowest = automatic ? 3 : options_.min_inliers;
+
+  std::vector<double> finite;
+  for (const Reading& r : readings)
+  {
+    if (std::isfinite(r.range))
+    {
+      finite.push_back(r.range);
+    }
+  }
+  double typical_range = 1.0;
+  if (!finite.empty())
+  {
+    std::nth_element(finite.begin(), finite.begin() + finite.size() / 2, finite.end());
+    typical_range = finite[finite.size() / 2];
+  }
+  RefinementSettings settings;
+  settings.agreement_tolerance = options_.agreement_tolerance;
+  settings.robust_scale = std::max(options_.agreement_tolerance,
+                                   1.5 * spec_.cell + spec_.thetaStep() * typical_range);
+  settings.noise_sigma = std::max(options_.range_tolerance / std::sqrt(3.0), 1e-4);
+  settings.seed_position_error = 1.5 * spec_.cell;
+  settings.seed_angle_error = spec_.thetaStep();
+
+  auto stage = std::chrono::steady_clock::now();
+  const std::vector<std::vector<std::size_t>> buckets = voxelsByCount(count_, lowest, k);
+  result.times.components += secondsSince(stage);
+
+  std::vector<Seed> seeds;
+  int used_level = lowest;
+  for (int level = k; level >= lowest; --level)
+  {
+    stage = std::chrono::steady_clock::now();
+    const std::vector<VoxelCluster> maxima = regionalMaxima(spec_, count_, level, buckets[level]);
+    result.times.components += secondsSince(stage);
+
+    const std::size_t first = seeds.size();
+    seeds.resize(first + maxima.size());
+    stage = std::chrono::steady_clock::now();
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads())
+    for (long c = 0; c < static_cast<long>(maxima.size()); ++c)
+    {
+      Seed& seed = seeds[first + c];
+      seed.voxel = maxima[c].representative;
+      seed.candidate = verifiedCandidate(*map_, maxima[c].centroid, readings, options_.agreement_tolerance);
+    }
+    result.times.verification += secondsSince(stage);
+
+    stage = std::chrono::steady_clock::now();
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads())
+    for (long c = 0; c < static_cast<long>(maxima.size()); ++c)
+    {
+      Seed& seed = seeds[first + c];
+      const VoxelCluster& cluster = maxima[c];
+      const std::vector<bool> hypothesis = membership(seed.voxel);
+      seed.candidate = refineSeed(*map_, cluster.centroid, readings, hypothesis, settings);
+      // A seed that explains fewer readings than its count promises may sit behind an occlusion
+      // edge: retry from other voxels of the plateau (only for the first seeds of the call, so
+      // junk at low levels stays cheap and the result does not depend on thread timing).
+      if (seed.candidate.inliers < level && first + c < kRetriedSeeds)
+      {
+        const std::size_t n = cluster.voxels.size();
+        for (std::size_t v : { cluster.representative, cluster.voxels[n / 3], cluster.voxels[(2 * n) / 3] })
+        {
+          Candidate retry = refineSeed(*map_, spec_.centre(v), readings, hypothesis, settings);
+          if (betterCandidate(retry, seed.candidate))
+          {
+            seed.candidate = std::move(retry);
+          }
+          if (seed.candidate.inliers >= level)
+          {
+            break;
+          }
+        }
+      }
+    }
+    result.times.polish += secondsSince(stage);
+
+    if (automatic)
+    {
+      const bool found = std::any_of(seeds.begin(), seeds.end(),
+                                     [&](const Seed& s) { return s.candidate.inliers >= level; });
+      if (found)
+      {
+        used_level = level;
+        break;
+      }
+    }
+  }
+  result.min_inliers_used = automatic ? used_level : options_.min_inliers;
+
+  std::vector<Candidate> kept;
+  for (Seed& seed : seeds)
+  {
+    if (seed.candidate.inliers >= result.min_inliers_used)
+    {
+      // The seed voxel rides in support until the duplicates are gone.
+      seed.candidate.support = static_cast<double>(seed.voxel);
+      kept.push_back(std::move(seed.candidate));
+    }
+  }
+  result.candidates = rankAndDeduplicate(std::move(kept), options_.uniqueness_distance,
+                                         options_.uniqueness_angle, options_.max_candidates);
+  stage = std::chrono::steady_clock::now();
+  for (Candidate& c : result.candidates)
+  {
+    const auto voxel = static_cast<std::size_t>(c.support);
+    c.support = static_cast<double>(componentSize(spec_, count_, result.min_inliers_used, voxel));
+  }
+  result.times.components += secondsSince(stage);
+}
+
+}  // namespace core
+}  // namespace fdml_localization

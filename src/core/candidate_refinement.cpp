@@ -298,6 +298,22 @@ Candidate refineSeed(const MapRayCaster& map, const Pose2& seed, const std::vect
   auto polishOn = [&](const std::vector<bool>& use, double scale) {
     return polishPose(map, best_pose, readings, use, scale, settings.max_iterations, settings.noise_sigma);
   };
+  // Graduated robustness: the Cauchy scale shrinks from about the seed's error to eps, so
+  // readings cut short by unknown obstacles lose their pull as the pose settles.
+  auto annealFrom = [&](const Pose2& start, const std::vector<bool>& use) {
+    PolishOutcome stage;
+    stage.pose = start;
+    for (double scale = settings.robust_scale;; scale *= 0.4)
+    {
+      const double s = std::max(scale, eps);
+      stage = polishPose(map, stage.pose, readings, use, s, settings.max_iterations, settings.noise_sigma);
+      if (s <= eps)
+      {
+        break;
+      }
+    }
+    consider(stage);
+  };
   auto finiteInliers = [&](int drop) {
     std::vector<bool> use(readings.size(), false);
     for (std::size_t i = 0; i < readings.size(); ++i)
@@ -348,10 +364,10 @@ Candidate refineSeed(const MapRayCaster& map, const Pose2& seed, const std::vect
       use[i] = false;
       --remaining;
     }
-    consider(polishOn(use, settings.robust_scale));
+    annealFrom(seed, use);
     if (use != hypothesis)
     {
-      consider(polishOn(hypothesis, settings.robust_scale));
+      annealFrom(seed, hypothesis);
     }
   }
   polishRounds();
@@ -359,7 +375,8 @@ Candidate refineSeed(const MapRayCaster& map, const Pose2& seed, const std::vect
   // between here and the optimum can hold the polish in a false minimum. Leave out, one at a
   // time, the readings passing nearest to a vertex and the worst one, and keep the result
   // when the consensus improves.
-  for (int attempt = 0; attempt < settings.max_escapes && best.rms > 1e-9; ++attempt)
+  for (int attempt = 0;
+       attempt < settings.max_escapes && best.rms > 1e-9 && best.inliers >= settings.escape_min_inliers; ++attempt)
   {
     std::vector<int> order;
     for (std::size_t i = 0; i < readings.size(); ++i)

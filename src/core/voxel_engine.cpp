@@ -4,10 +4,16 @@
 #include "fdml_localization/core/components.h"
 
 #include <omp.h>
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
+#include <limits>
+#include <numeric>
 
 namespace fdml_localization
 {
@@ -21,12 +27,61 @@ double secondsSince(std::chrono::steady_clock::time_point start)
 }
 
 /// Seeds (in processing order) that may be retried from other voxels of their plateau.
-constexpr std::size_t kRetriedSeeds = 64;
+constexpr long kRetriedSeeds = 32;
 
 int floorDiv(double value)
 {
   return static_cast<int>(std::floor(value));
 }
+
+/// Sets bit ix of @p row for ix in [begin, end) when [rmin[ix], rmax[ix]] meets [lo, hi]
+/// (no_return: when rmax[ix] >= lo).
+void markRow(const float* rmin, const float* rmax, int begin, int end, float lo, float hi, bool no_return,
+             std::uint64_t* row)
+{
+  auto scalar = [&](int ix) {
+    const bool in = no_return ? rmax[ix] >= lo : (rmin[ix] <= hi && rmax[ix] >= lo);
+    row[ix >> 6] |= static_cast<std::uint64_t>(in) << (ix & 63);
+  };
+  int ix = begin;
+#ifdef __SSE2__
+  for (; ix < end && (ix & 3) != 0; ++ix)
+  {
+    scalar(ix);
+  }
+  // Four voxels per step; an aligned group of four never straddles two words.
+  const __m128 vlo = _mm_set1_ps(lo);
+  const __m128 vhi = _mm_set1_ps(no_return ? std::numeric_limits<float>::infinity() : hi);
+  for (; ix + 4 <= end; ix += 4)
+  {
+    const __m128 in = _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(rmin + ix), vhi), _mm_cmpge_ps(_mm_loadu_ps(rmax + ix), vlo));
+    row[ix >> 6] |= static_cast<std::uint64_t>(_mm_movemask_ps(in)) << (ix & 63);
+  }
+#endif
+  for (; ix < end; ++ix)
+  {
+    scalar(ix);
+  }
+}
+
+/// byte_spread[b] has byte j = bit j of b: adds 8 voxels' bits to 8 count bytes at once.
+struct ByteSpread
+{
+  std::uint64_t table[256];
+  ByteSpread()
+  {
+    for (int b = 0; b < 256; ++b)
+    {
+      std::uint64_t v = 0;
+      for (int j = 0; j < 8; ++j)
+      {
+        v |= static_cast<std::uint64_t>((b >> j) & 1) << (8 * j);
+      }
+      table[b] = v;
+    }
+  }
+};
+const ByteSpread kByteSpread;
 }  // namespace
 
 VoxelEngine::VoxelEngine(std::shared_ptr<const MapRayCaster> map, const LocalizerOptions& options)
@@ -62,62 +117,79 @@ const DistanceTable& VoxelEngine::table()
   return table_;
 }
 
-VoxelSet VoxelEngine::rawPreimage(const Reading& reading)
+void VoxelEngine::fillPreimageSlice(const Reading& reading, int it, VoxelSet& set) const
 {
-  prepare();
-  VoxelSet set(spec_);
   const int nx = spec_.nx;
   const int ny = spec_.ny;
   const int nt = spec_.nt;
-  const double dt = spec_.thetaStep();
   const bool no_return = !std::isfinite(reading.range);
   const float lo = static_cast<float>(no_return ? reading.max_range - options_.range_tolerance
                                                 : reading.range - options_.range_tolerance);
   const float hi = static_cast<float>(reading.range + options_.range_tolerance);
   const std::size_t slice = static_cast<std::size_t>(nx) * ny;
+  const double theta = spec_.centreTheta(it);
+  const double c = std::cos(theta);
+  const double s = std::sin(theta);
+  // (centre of voxel (ix, iy, it)) (+) g sits at sample-lattice coordinate (ix + ox / cell, ...):
+  // the same shift for the whole slice, so its sample block starts at (ix + sx, iy + sy, t0).
+  const double ox = c * reading.offset.x - s * reading.offset.y;
+  const double oy = s * reading.offset.x + c * reading.offset.y;
+  const int sx = floorDiv(ox / spec_.cell);
+  const int sy = floorDiv(oy / spec_.cell);
+  const double phi = wrapAngle(theta + reading.offset.theta);
+  int t0 = floorDiv((phi + kPi) / spec_.thetaStep() - 0.5) % nt;
+  t0 = t0 < 0 ? t0 + nt : t0;
+  // Blocks start at samples xx in [0, nx - 2] and yy in [0, ny - 2].
+  const int x_begin = std::max(0, -sx);
+  const int x_end = std::min(nx, nx - 1 - sx);
+  const int y_begin = std::max(0, -sy);
+  const int y_end = std::min(ny, ny - 1 - sy);
   const float* bmin = table_.blockMin().data();
   const float* bmax = table_.blockMax().data();
-#pragma omp parallel for schedule(static) num_threads(threads())
-  for (int it = 0; it < nt; ++it)
+  for (int iy = y_begin; iy < y_end; ++iy)
   {
-    const double theta = spec_.centreTheta(it);
-    const double c = std::cos(theta);
-    const double s = std::sin(theta);
-    const double ox = c * reading.offset.x - s * reading.offset.y;
-    const double oy = s * reading.offset.x + c * reading.offset.y;
-    const int sx = floorDiv(ox / spec_.cell);
-    const int sy = floorDiv(oy / spec_.cell);
-    const double phi = wrapAngle(theta + reading.offset.theta);
-    int t0 = floorDiv((phi + kPi) / dt - 0.5) % nt;
-    t0 = t0 < 0 ? t0 + nt : t0;
-    // Blocks start at sample xx in [0, nx - 2] and yy in [0, ny - 2].
-    const int x_begin = std::max(0, -sx);
-    const int x_end = std::min(nx, nx - 1 - sx);
-    const int y_begin = std::max(0, -sy);
-    const int y_end = std::min(ny, ny - 1 - sy);
-    for (int iy = y_begin; iy < y_end; ++iy)
-    {
-      const std::size_t base = static_cast<std::size_t>(t0) * slice + static_cast<std::size_t>(iy + sy) * nx + sx;
-      const float* rmin = bmin + base;
-      const float* rmax = bmax + base;
-      std::uint64_t* row = set.row(iy, it);
-      for (int ix = x_begin; ix < x_end; ++ix)
-      {
-        const bool in = no_return ? rmax[ix] >= lo : (rmin[ix] <= hi && rmax[ix] >= lo);
-        row[ix >> 6] |= static_cast<std::uint64_t>(in) << (ix & 63);
-      }
-    }
+    const std::size_t base = static_cast<std::size_t>(t0) * slice + static_cast<std::size_t>(iy + sy) * nx + sx;
+    markRow(bmin + base, bmax + base, x_begin, x_end, lo, hi, no_return, set.row(iy, it));
+  }
+}
+
+VoxelSet VoxelEngine::rawPreimage(const Reading& reading)
+{
+  prepare();
+  VoxelSet set(spec_);
+#pragma omp parallel for schedule(static) num_threads(threads())
+  for (int it = 0; it < spec_.nt; ++it)
+  {
+    fillPreimageSlice(reading, it, set);
   }
   return set;
 }
 
 std::vector<VoxelSet> VoxelEngine::preimages(const std::vector<Reading>& readings)
 {
-  std::vector<VoxelSet> sets;
-  sets.reserve(readings.size());
-  for (const Reading& reading : readings)
+  std::vector<VoxelSet> raw;
+  return preimages(readings, raw);
+}
+
+std::vector<VoxelSet> VoxelEngine::preimages(const std::vector<Reading>& readings, std::vector<VoxelSet>& raw)
+{
+  prepare();
+  const long k = static_cast<long>(readings.size());
+  const long nt = spec_.nt;
+  raw.assign(readings.size(), VoxelSet(spec_));
+  std::vector<VoxelSet> sets(readings.size());
+#pragma omp parallel num_threads(threads())
   {
-    sets.push_back(rawPreimage(reading).dilated());
+#pragma omp for schedule(static)
+    for (long job = 0; job < k * nt; ++job)
+    {
+      fillPreimageSlice(readings[job / nt], static_cast<int>(job % nt), raw[job / nt]);
+    }
+#pragma omp for schedule(dynamic, 1)
+    for (long i = 0; i < k; ++i)
+    {
+      sets[i] = raw[i].dilated();
+    }
   }
   return sets;
 }
@@ -139,30 +211,51 @@ void VoxelEngine::countField(const std::vector<VoxelSet>& sets, std::vector<std:
         std::uint8_t* out = count.data() + spec_.index(0, iy, it);
         for (int k = 0; k < set.wordsPerRow(); ++k)
         {
-          std::uint64_t w = row[k];
-          while (w)
+          const std::uint64_t w = row[k];
+          if (w == 0)
           {
-            const int bit = __builtin_ctzll(w);
-            ++out[k * 64 + bit];
-            w &= w - 1;
+            continue;
+          }
+          for (int j = 0; j < 8; ++j)
+          {
+            const auto byte = static_cast<unsigned>((w >> (8 * j)) & 0xffu);
+            const int ix = 64 * k + 8 * j;
+            if (byte == 0)
+            {
+              continue;
+            }
+            if (ix + 8 <= nx)
+            {
+              // Eight counts at once: no byte overflows (at most 255 sets).
+              std::uint64_t eight = 0;
+              std::memcpy(&eight, out + ix, 8);
+              eight += kByteSpread.table[byte];
+              std::memcpy(out + ix, &eight, 8);
+            }
+            else
+            {
+              for (int b = 0; b < 8 && ix + b < nx; ++b)
+              {
+                out[ix + b] = static_cast<std::uint8_t>(out[ix + b] + ((byte >> b) & 1u));
+              }
+            }
           }
         }
       }
     }
   }
-  (void)nx;
 }
 
-std::vector<bool> VoxelEngine::membership(std::size_t voxel) const
+std::vector<bool> VoxelEngine::membership(std::size_t voxel, const std::vector<VoxelSet>& sets) const
 {
   int ix = 0;
   int iy = 0;
   int it = 0;
   spec_.unindex(voxel, ix, iy, it);
-  std::vector<bool> in(sets_.size(), false);
-  for (std::size_t i = 0; i < sets_.size(); ++i)
+  std::vector<bool> in(sets.size(), false);
+  for (std::size_t i = 0; i < sets.size(); ++i)
   {
-    in[i] = sets_[i].test(ix, iy, it);
+    in[i] = sets[i].test(ix, iy, it);
   }
   return in;
 }
@@ -182,11 +275,15 @@ Result VoxelEngine::localize(const std::vector<Reading>& readings)
   }
 
   auto stage = std::chrono::steady_clock::now();
-  sets_ = preimages(readings);
+  sets_ = preimages(readings, raw_sets_);
   result.times.preimages = secondsSince(stage);
 
   stage = std::chrono::steady_clock::now();
   countField(sets_, count_);
+  if (options_.method == Method::Robust)
+  {
+    countField(raw_sets_, raw_count_);
+  }
   result.times.count = secondsSince(stage);
 
   const int k = static_cast<int>(readings.size());
@@ -258,13 +355,16 @@ void VoxelEngine::localizeRobust(const std::vector<Reading>& readings, Result& r
   RefinementSettings settings;
   settings.agreement_tolerance = options_.agreement_tolerance;
   settings.robust_scale = std::max(options_.agreement_tolerance,
-                                   1.5 * spec_.cell + spec_.thetaStep() * typical_range);
+                                   0.5 * spec_.cell + 0.5 * spec_.thetaStep() * typical_range);
   settings.noise_sigma = std::max(options_.range_tolerance / std::sqrt(3.0), 1e-4);
   settings.seed_position_error = 1.5 * spec_.cell;
   settings.seed_angle_error = spec_.thetaStep();
 
+  // Seeds come from the count peaks of the dilated preimages and, because the dilation can
+  // merge an obstacle hit's surface into the truth's peak, also from those of the raw ones.
   auto stage = std::chrono::steady_clock::now();
   const std::vector<std::vector<std::size_t>> buckets = voxelsByCount(count_, lowest, k);
+  const std::vector<std::vector<std::size_t>> raw_buckets = voxelsByCount(raw_count_, lowest, k);
   result.times.components += secondsSince(stage);
 
   std::vector<Seed> seeds;
@@ -272,45 +372,61 @@ void VoxelEngine::localizeRobust(const std::vector<Reading>& readings, Result& r
   for (int level = k; level >= lowest; --level)
   {
     stage = std::chrono::steady_clock::now();
-    const std::vector<VoxelCluster> maxima = regionalMaxima(spec_, count_, level, buckets[level]);
+    std::vector<VoxelCluster> maxima = regionalMaxima(spec_, count_, level, buckets[level]);
+    const std::size_t dilated_maxima = maxima.size();
+    for (VoxelCluster& c : regionalMaxima(spec_, raw_count_, level, raw_buckets[level]))
+    {
+      maxima.push_back(std::move(c));
+    }
     result.times.components += secondsSince(stage);
 
     const std::size_t first = seeds.size();
     seeds.resize(first + maxima.size());
+    std::vector<std::vector<bool>> hypotheses(maxima.size());
     stage = std::chrono::steady_clock::now();
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads())
     for (long c = 0; c < static_cast<long>(maxima.size()); ++c)
     {
       Seed& seed = seeds[first + c];
       seed.voxel = maxima[c].representative;
+      hypotheses[c] = membership(seed.voxel, static_cast<std::size_t>(c) < dilated_maxima ? sets_ : raw_sets_);
       seed.candidate = verifiedCandidate(*map_, maxima[c].centroid, readings, options_.agreement_tolerance);
     }
     result.times.verification += secondsSince(stage);
 
     stage = std::chrono::steady_clock::now();
+    RefinementSettings level_settings = settings;
+    level_settings.escape_min_inliers = std::max(3, level - 1);
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads())
     for (long c = 0; c < static_cast<long>(maxima.size()); ++c)
     {
-      Seed& seed = seeds[first + c];
-      const VoxelCluster& cluster = maxima[c];
-      const std::vector<bool> hypothesis = membership(seed.voxel);
-      seed.candidate = refineSeed(*map_, cluster.centroid, readings, hypothesis, settings);
-      // A seed that explains fewer readings than its count promises may sit behind an occlusion
-      // edge: retry from other voxels of the plateau (only for the first seeds of the call, so
-      // junk at low levels stays cheap and the result does not depend on thread timing).
-      if (seed.candidate.inliers < level && first + c < kRetriedSeeds)
+      seeds[first + c].candidate = refineSeed(*map_, maxima[c].centroid, readings, hypotheses[c], level_settings);
+    }
+    // No seed so far explains as many readings as this level's count promises: one of this
+    // level's seeds may sit behind an occlusion edge. Retry the first of them from other voxels
+    // of their plateaus (a fixed number, so the result does not depend on thread timing).
+    const int best_so_far = std::accumulate(seeds.begin(), seeds.end(), 0, [](int m, const Seed& s) {
+      return std::max(m, s.candidate.inliers);
+    });
+    if (best_so_far < level)
+    {
+      const long retried = std::min<long>(static_cast<long>(maxima.size()), kRetriedSeeds);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads())
+      for (long c = 0; c < retried; ++c)
       {
+        Seed& seed = seeds[first + c];
+        const VoxelCluster& cluster = maxima[c];
         const std::size_t n = cluster.voxels.size();
         for (std::size_t v : { cluster.representative, cluster.voxels[n / 3], cluster.voxels[(2 * n) / 3] })
         {
-          Candidate retry = refineSeed(*map_, spec_.centre(v), readings, hypothesis, settings);
-          if (betterCandidate(retry, seed.candidate))
-          {
-            seed.candidate = std::move(retry);
-          }
           if (seed.candidate.inliers >= level)
           {
             break;
+          }
+          Candidate retry = refineSeed(*map_, spec_.centre(v), readings, hypotheses[c], level_settings);
+          if (betterCandidate(retry, seed.candidate))
+          {
+            seed.candidate = std::move(retry);
           }
         }
       }

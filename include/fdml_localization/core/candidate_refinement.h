@@ -68,6 +68,7 @@ struct RefinementSettings
   int max_rounds = 3;                 ///< re-polish on the new inlier set at most this often
   int max_escapes = 3;                ///< leave-one-out rounds to escape a false minimum
   int escape_tries = 4;               ///< readings tried per leave-one-out round
+  int escape_min_inliers = 3;         ///< only candidates with this many inliers try to escape
 };
 
 /**

@@ -46,6 +46,8 @@ public:
   VoxelSet rawPreimage(const Reading& reading);
   /// The dilated preimages of a batch, one per reading.
   std::vector<VoxelSet> preimages(const std::vector<Reading>& readings);
+  /// The same, also returning the preimages before dilation in @p raw.
+  std::vector<VoxelSet> preimages(const std::vector<Reading>& readings, std::vector<VoxelSet>& raw);
   /// count[v] = number of sets holding voxel v (at most 255 sets).
   void countField(const std::vector<VoxelSet>& sets, std::vector<std::uint8_t>& count) const;
 
@@ -61,9 +63,10 @@ private:
   };
 
   int threads() const;
+  void fillPreimageSlice(const Reading& reading, int it, VoxelSet& set) const;
   void localizeRobust(const std::vector<Reading>& readings, Result& result);
   void localizeComponentCentres(const std::vector<Reading>& readings, int min_inliers, Result& result);
-  std::vector<bool> membership(std::size_t voxel) const;
+  std::vector<bool> membership(std::size_t voxel, const std::vector<VoxelSet>& sets) const;
 
   std::shared_ptr<const MapRayCaster> map_;
   LocalizerOptions options_;
@@ -75,7 +78,9 @@ private:
   TableSource table_source_ = TableSource::Built;
   std::string cache_message_;
   std::vector<VoxelSet> sets_;
+  std::vector<VoxelSet> raw_sets_;
   std::vector<std::uint8_t> count_;
+  std::vector<std::uint8_t> raw_count_;  ///< count of the raw preimages (seeding only)
 };
 
 }  // namespace core

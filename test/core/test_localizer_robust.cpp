@@ -1,0 +1,215 @@
+// Robustness: readings cut short by unknown obstacles, the paper's and the baseline's
+// semantics, no-return readings and sensor noise.
+#include "fdml_localization/core/voxel_engine.h"
+
+#include "localizer_test_utils.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <numeric>
+
+namespace fdml_localization
+{
+namespace core
+{
+namespace
+{
+using test::angleError;
+using test::positionError;
+
+constexpr double kDeg = kPi / 180.0;
+
+struct OutlierTrial
+{
+  Pose2 truth;
+  std::vector<Reading> readings;
+  std::vector<bool> is_outlier;
+};
+
+/// 10 exact readings in place, 4 of them (random) replaced by shorter ones (obstacle hits).
+OutlierTrial outlierTrial(const MapRayCaster& map, std::mt19937_64& rng)
+{
+  OutlierTrial t;
+  t.truth = test::randomFreePose(map, rng);
+  t.readings = test::exactReadings(map, t.truth, test::inPlaceOffsets(10));
+  t.is_outlier.assign(10, false);
+  std::vector<int> order(10);
+  std::iota(order.begin(), order.end(), 0);
+  std::shuffle(order.begin(), order.end(), rng);
+  std::uniform_real_distribution<double> shrink(0.1, 0.8);
+  for (int j = 0; j < 4; ++j)
+  {
+    t.readings[order[j]].range *= shrink(rng);
+    t.is_outlier[order[j]] = true;
+  }
+  return t;
+}
+
+bool foundWithMask(const Result& result, const OutlierTrial& t)
+{
+  const Candidate* c = test::nearestCandidate(result, t.truth);
+  if (!c || positionError(c->pose, t.truth) > 1e-3 || angleError(c->pose, t.truth) > 0.05 * kDeg)
+  {
+    return false;
+  }
+  for (std::size_t i = 0; i < t.is_outlier.size(); ++i)
+  {
+    if (c->inlier_mask[i] == t.is_outlier[i])
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+bool foundNear(const Result& result, const Pose2& truth, double distance, double angle)
+{
+  const Candidate* c = test::nearestCandidate(result, truth);
+  return c && positionError(c->pose, truth) < distance && angleError(c->pose, truth) < angle;
+}
+
+TEST(LocalizerRobust, FourOfTenReadingsHitObstacles)
+{
+  const auto map = test::lRoomMap();
+  LocalizerOptions robust;
+  robust.resolution = 64;
+  LocalizerOptions fixed = robust;
+  fixed.min_inliers = 6;
+  LocalizerOptions baseline = robust;
+  baseline.method = Method::Baseline;
+  baseline.agreement_tolerance = 0.2;  // generous: the baseline has no polish
+  Localizer auto_localizer(map, robust);
+  Localizer fixed_localizer(map, fixed);
+  Localizer baseline_localizer(map, baseline);
+  std::mt19937_64 rng(21);
+  const int trials = 100;
+  int auto_found = 0;
+  int fixed_found = 0;
+  int baseline_found = 0;
+  int top1 = 0;
+  for (int trial = 0; trial < trials; ++trial)
+  {
+    const OutlierTrial t = outlierTrial(*map, rng);
+    const Result a = auto_localizer.localize(t.readings);
+    auto_found += foundWithMask(a, t) ? 1 : 0;
+    top1 += !a.candidates.empty() && positionError(a.candidates[0].pose, t.truth) < 1e-3 ? 1 : 0;
+    fixed_found += foundWithMask(fixed_localizer.localize(t.readings), t) ? 1 : 0;
+    const Result b = baseline_localizer.localize(t.readings);
+    EXPECT_EQ(b.min_inliers_used, 10);
+    baseline_found += foundNear(b, t.truth, 0.05, 2 * kDeg) ? 1 : 0;
+  }
+  std::printf("[ STATS    ] 4 outliers of 10, %d trials: robust auto %d (top-1 %d), robust k'=6 %d, "
+              "baseline %d (fails %d)\n",
+              trials, auto_found, top1, fixed_found, baseline_found, trials - baseline_found);
+  EXPECT_GE(auto_found, 95);
+  EXPECT_GE(fixed_found, 95);
+  EXPECT_LT(baseline_found, 10);
+}
+
+TEST(LocalizerRobust, PaperModeFindsComponentCentresWithoutPolish)
+{
+  const auto map = test::lRoomMap();
+  LocalizerOptions paper;
+  paper.resolution = 64;
+  paper.method = Method::Paper;
+  paper.min_inliers = 6;
+  paper.agreement_tolerance = 0.3;
+  Localizer localizer(map, paper);
+  const GridSpec spec = GridSpec::fromMap(map->map(), 64, 0);
+  std::mt19937_64 rng(8);
+  const int trials = 40;
+  int found = 0;
+  for (int trial = 0; trial < trials; ++trial)
+  {
+    const OutlierTrial t = outlierTrial(*map, rng);
+    const Result r = localizer.localize(t.readings);
+    EXPECT_EQ(r.min_inliers_used, 6);
+    EXPECT_EQ(r.times.polish, 0.0);
+    for (const Candidate& c : r.candidates)
+    {
+      EXPECT_GE(c.inliers, 6);
+      EXPECT_GT(c.support, 0.0);
+    }
+    found += foundNear(r, t.truth, 2.0 * spec.cell, 2.0 * spec.thetaStep()) ? 1 : 0;
+  }
+  std::printf("[ STATS    ] paper mode k'=6: truth within 2 voxels in %d / %d\n", found, trials);
+  EXPECT_GE(found, trials * 8 / 10);
+}
+
+TEST(LocalizerRobust, NoReturnReadingsAreUsedAndAgree)
+{
+  // A long corridor of 20 x 1 m: with a 3 m sensor, the readings along it return nothing.
+  std::vector<Ring> rings = { { Vec2(0, 0), Vec2(20, 0), Vec2(20, 1), Vec2(0, 1) },
+                              { Vec2(4, 0.4), Vec2(4.3, 0.4), Vec2(4.3, 0.6), Vec2(4, 0.6) } };
+  const auto map = std::make_shared<const MapRayCaster>(PolygonMap::fromRings(rings, "corridor"));
+  LocalizerOptions options;
+  options.resolution = 400;
+  options.theta_resolution = 64;
+  Localizer localizer(map, options);
+  const Pose2 truth(5.0, 0.3, 0.05);
+  std::vector<Reading> readings = test::exactReadings(*map, truth, test::inPlaceOffsets(8));
+  int no_return = 0;
+  for (Reading& r : readings)
+  {
+    r.max_range = 3.0;
+    if (r.range > r.max_range)
+    {
+      r.range = kInf;
+      ++no_return;
+    }
+  }
+  ASSERT_GE(no_return, 1);
+  const Result result = localizer.localize(readings);
+  ASSERT_FALSE(result.candidates.empty());
+  const Candidate* c = test::nearestCandidate(result, truth);
+  ASSERT_NE(c, nullptr);
+  EXPECT_LT(positionError(c->pose, truth), 1e-3);
+  EXPECT_EQ(c->inliers, 8);
+  // Without the no-return constraints, more places fit the remaining readings.
+  std::vector<Reading> finite;
+  for (const Reading& r : readings)
+  {
+    if (std::isfinite(r.range))
+    {
+      finite.push_back(r);
+    }
+  }
+  if (finite.size() >= 3)
+  {
+    const Result loose = localizer.localize(finite);
+    EXPECT_GE(loose.candidates.size(), result.candidates.size());
+  }
+}
+
+TEST(LocalizerRobust, SensorNoiseWithinTheRangeTolerance)
+{
+  const auto map = test::lRoomMap();
+  LocalizerOptions options;
+  options.resolution = 64;
+  options.range_tolerance = 0.03;
+  options.agreement_tolerance = 0.05;
+  Localizer localizer(map, options);
+  std::mt19937_64 rng(4);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  const int trials = 50;
+  int found = 0;
+  for (int trial = 0; trial < trials; ++trial)
+  {
+    const Pose2 truth = test::randomFreePose(*map, rng, 0.1);
+    std::vector<Reading> readings = test::exactReadings(*map, truth, test::inPlaceOffsets(10));
+    for (Reading& r : readings)
+    {
+      r.range = std::max(0.0, r.range + noise(rng));
+    }
+    const Result result = localizer.localize(readings);
+    found += foundNear(result, truth, 0.05, 2 * kDeg) ? 1 : 0;
+  }
+  std::printf("[ STATS    ] noise 1 cm: truth within 5 cm / 2 deg in %d / %d\n", found, trials);
+  EXPECT_GE(found, trials * 9 / 10);
+}
+
+}  // namespace
+}  // namespace core
+}  // namespace fdml_localization

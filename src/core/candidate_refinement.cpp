@@ -281,6 +281,7 @@ Candidate refineSeed(const MapRayCaster& map, const Pose2& seed, const std::vect
   const double eps = settings.agreement_tolerance;
   Pose2 best_pose = seed;
   PoseEvaluation best = evaluatePose(map, seed, readings, eps);
+  const std::vector<double> best_seed_residuals = best.residuals;
   Eigen::Matrix3d best_cov = Eigen::Matrix3d::Identity() * 1e6;
 
   // Adopts a polished pose when it explains more readings, or as many with a lower RMS.
@@ -368,6 +369,23 @@ Candidate refineSeed(const MapRayCaster& map, const Pose2& seed, const std::vect
     if (use != hypothesis)
     {
       annealFrom(seed, hypothesis);
+    }
+    // Unknown obstacles only ever shorten readings: one far shorter than the map predicts at
+    // the seed is more likely an obstacle hit than the seed's error. Try without those too.
+    std::vector<bool> unshortened = hypothesis;
+    int kept = 0;
+    for (std::size_t i = 0; i < readings.size(); ++i)
+    {
+      const double r = best_seed_residuals[i];
+      if (unshortened[i] && std::isfinite(r) && r > 2.0 * settings.robust_scale)
+      {
+        unshortened[i] = false;
+      }
+      kept += unshortened[i] && std::isfinite(readings[i].range) ? 1 : 0;
+    }
+    if (unshortened != hypothesis && kept >= 4)
+    {
+      annealFrom(seed, unshortened);
     }
   }
   polishRounds();

@@ -134,10 +134,12 @@ void VoxelEngine::fillPreimageSlice(const Reading& reading, int it, VoxelSet& se
   // the same shift for the whole slice, so its sample block starts at (ix + sx, iy + sy, t0).
   const double ox = c * reading.offset.x - s * reading.offset.y;
   const double oy = s * reading.offset.x + c * reading.offset.y;
-  const int sx = floorDiv(ox / spec_.cell);
-  const int sy = floorDiv(oy / spec_.cell);
+  // A point exactly on a sample (g = 0, the first reading of a batch) takes the block that
+  // starts there, whatever the rounding of the lattice coordinate: hence the 1e-9.
+  const int sx = floorDiv(ox / spec_.cell + 1e-9);
+  const int sy = floorDiv(oy / spec_.cell + 1e-9);
   const double phi = wrapAngle(theta + reading.offset.theta);
-  int t0 = floorDiv((phi + kPi) / spec_.thetaStep() - 0.5) % nt;
+  int t0 = floorDiv((phi + kPi) / spec_.thetaStep() - 0.5 + 1e-9) % nt;
   t0 = t0 < 0 ? t0 + nt : t0;
   // Blocks start at samples xx in [0, nx - 2] and yy in [0, ny - 2].
   const int x_begin = std::max(0, -sx);

@@ -125,6 +125,32 @@ std::size_t componentSize(const GridSpec& spec, const std::vector<std::uint8_t>&
   return queue.size();
 }
 
+std::vector<std::size_t> componentSizes(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
+                                        const std::vector<std::size_t>& seeds)
+{
+  std::vector<std::size_t> sizes(seeds.size(), 0);
+  BitFlags visited(count.size());
+  std::vector<std::size_t> queue;
+  for (std::size_t i = 0; i < seeds.size(); ++i)
+  {
+    const std::size_t seed = seeds[i];
+    if (seed >= count.size() || count[seed] < level || visited.test(seed))
+    {
+      continue;
+    }
+    flood(spec, seed, visited, queue, [&](std::size_t u) { return count[u] >= level; }, [](std::size_t) {});
+    // Every later seed flooded now lies in this component.
+    for (std::size_t j = i; j < seeds.size(); ++j)
+    {
+      if (sizes[j] == 0 && seeds[j] < count.size() && visited.test(seeds[j]))
+      {
+        sizes[j] = queue.size();
+      }
+    }
+  }
+  return sizes;
+}
+
 std::vector<VoxelCluster> regionalMaxima(const GridSpec& spec, const std::vector<std::uint8_t>& count,
                                          int level, const std::vector<std::size_t>& candidates)
 {

@@ -71,6 +71,10 @@ std::vector<VoxelCluster> connectedComponents(const GridSpec& spec, const std::v
 std::size_t componentSize(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
                           std::size_t seed);
 
+/// componentSize() for several seeds at once; each component is flooded once.
+std::vector<std::size_t> componentSizes(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
+                                        const std::vector<std::size_t>& seeds);
+
 /**
  * @brief The regional maxima of the count field at exactly @p level: connected plateaus of
  *        voxels with count == level none of whose neighbours has a higher count. Every count

@@ -37,7 +37,7 @@ void VoxelEngine::localizeComponentCentres(const std::vector<Reading>& readings,
 
   stage = std::chrono::steady_clock::now();
   std::vector<Candidate> candidates(clusters.size());
-#pragma omp parallel for schedule(dynamic, 4) num_threads(threads())
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads()) if (clusters.size() >= 8)
   for (long c = 0; c < static_cast<long>(clusters.size()); ++c)
   {
     candidates[c] = verifiedCandidate(*map_, clusters[c].centroid, readings, options_.agreement_tolerance);
@@ -111,7 +111,7 @@ void VoxelEngine::localizeRobust(const std::vector<Reading>& readings, Result& r
     std::vector<std::vector<bool>> hypotheses(maxima.size());
     std::vector<char> plausible(maxima.size(), 0);
     stage = std::chrono::steady_clock::now();
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads())
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads()) if (maxima.size() >= 4)
     for (long c = 0; c < static_cast<long>(maxima.size()); ++c)
     {
       Seed& seed = seeds[first + c];
@@ -125,7 +125,7 @@ void VoxelEngine::localizeRobust(const std::vector<Reading>& readings, Result& r
     stage = std::chrono::steady_clock::now();
     RefinementSettings level_settings = settings;
     level_settings.escape_min_inliers = std::max(3, level - 1);
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads())
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads()) if (maxima.size() >= 4)
     for (long c = 0; c < static_cast<long>(maxima.size()); ++c)
     {
       if (plausible[c])
@@ -142,7 +142,7 @@ void VoxelEngine::localizeRobust(const std::vector<Reading>& readings, Result& r
     if (best_so_far < level)
     {
       const long retried = std::min<long>(static_cast<long>(maxima.size()), kRetriedSeeds);
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads())
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads()) if (retried >= 4)
       for (long c = 0; c < retried; ++c)
       {
         Seed& seed = seeds[first + c];

@@ -34,6 +34,7 @@ AccuracyStats runExactTrials(const std::shared_ptr<const MapRayCaster>& map, int
 {
   LocalizerOptions options;
   options.resolution = resolution;
+  options.threads = 1;  // many short calls: keep the suite fast on a loaded machine
   VoxelEngine engine(map, options);
   std::mt19937_64 rng(seed);
   AccuracyStats stats;

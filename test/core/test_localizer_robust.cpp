@@ -75,6 +75,7 @@ TEST(LocalizerRobust, FourOfTenReadingsHitObstacles)
   const auto map = test::lRoomMap();
   LocalizerOptions robust;
   robust.resolution = 64;
+  robust.threads = 1;  // many short calls: keep the suite fast on a loaded machine
   LocalizerOptions fixed = robust;
   fixed.min_inliers = 6;
   LocalizerOptions baseline = robust;

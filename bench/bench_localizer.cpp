@@ -16,6 +16,7 @@
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
@@ -133,6 +134,7 @@ void localize(benchmark::State& state, const std::string& path, int n, int min_i
     batches.push_back(protocolBatch(map, rng));
   }
   core::StageTimes sum;
+  std::vector<double> totals;
   long calls = 0;
   double candidates = 0.0;
   for (auto _ : state)
@@ -143,6 +145,7 @@ void localize(benchmark::State& state, const std::string& path, int n, int min_i
     sum.components += result.times.components;
     sum.verification += result.times.verification;
     sum.polish += result.times.polish;
+    totals.push_back(result.times.total);
     candidates += static_cast<double>(result.candidates.size());
     ++calls;
   }
@@ -152,6 +155,8 @@ void localize(benchmark::State& state, const std::string& path, int n, int min_i
   state.counters["components_ms"] = sum.components * scale;
   state.counters["verification_ms"] = sum.verification * scale;
   state.counters["polish_ms"] = sum.polish * scale;
+  std::sort(totals.begin(), totals.end());
+  state.counters["median_ms"] = totals.empty() ? 0.0 : 1e3 * totals[totals.size() / 2];
   state.counters["candidates"] = candidates / static_cast<double>(std::max(calls, 1L));
   state.counters["peak_rss_mb"] = peakRssMb();
 }

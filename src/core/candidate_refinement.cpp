@@ -201,22 +201,67 @@ Candidate refineSeed(const MapRayCaster& map, const Pose2& seed, const std::vect
     {
       annealFrom(seed, hypothesis);
     }
-    // Unknown obstacles only ever shorten readings: one far shorter than the map predicts at
-    // the seed is more likely an obstacle hit than the seed's error. Try without those too.
-    std::vector<bool> unshortened = hypothesis;
-    int kept = 0;
+    // Unknown obstacles only ever shorten readings: the readings measured shortest relative to
+    // what the map predicts at the seed are the likeliest obstacle hits. While the seed does
+    // not yet explain target_inliers readings, leave out the 1, 2, ... most shortened ones.
+    std::vector<int> shortened;
     for (std::size_t i = 0; i < readings.size(); ++i)
     {
       const double r = best_seed_residuals[i];
-      if (unshortened[i] && std::isfinite(r) && r > 2.0 * settings.robust_scale)
+      if (hypothesis[i] && std::isfinite(r) && r > settings.agreement_tolerance)
       {
-        unshortened[i] = false;
+        shortened.push_back(static_cast<int>(i));
       }
-      kept += unshortened[i] && std::isfinite(readings[i].range) ? 1 : 0;
     }
-    if (unshortened != hypothesis && kept >= 4)
+    std::sort(shortened.begin(), shortened.end(), [&](int a, int b) {
+      return best_seed_residuals[a] / std::max(readings[a].range, 1e-3) >
+             best_seed_residuals[b] / std::max(readings[b].range, 1e-3);
+    });
+    std::vector<bool> trimmed = hypothesis;
+    int kept = static_cast<int>(std::count(hypothesis.begin(), hypothesis.end(), true));
+    for (std::size_t j = 0; j < shortened.size() && j < static_cast<std::size_t>(settings.max_dropped_shortened) &&
+                            best.inliers < settings.target_inliers && kept > 4;
+         ++j)
     {
-      annealFrom(seed, unshortened);
+      trimmed[shortened[j]] = false;
+      --kept;
+      annealFrom(seed, trimmed);
+    }
+  }
+  // Still short of the target: the seed may sit across occlusion edges from the optimum, where
+  // no descent reaches it. Search a small lattice around the seed for the pose where the most
+  // readings roughly agree, and polish from there on those readings.
+  if (settings.local_search_cells > 0 && best.inliers < settings.target_inliers)
+  {
+    const int m = settings.local_search_cells;
+    const double tol = 0.5 * settings.robust_scale;
+    Pose2 best_start = seed;
+    PoseEvaluation best_rough = evaluatePose(map, seed, readings, tol);
+    for (int a = -m; a <= m; ++a)
+    {
+      for (int b = -m; b <= m; ++b)
+      {
+        for (int c = -m; c <= m; ++c)
+        {
+          const Pose2 p(seed.x + a * settings.local_search_step, seed.y + b * settings.local_search_step,
+                        wrapAngle(seed.theta + c * settings.local_search_angle_step));
+          PoseEvaluation rough = evaluatePose(map, p, readings, tol);
+          if (rough.inliers > best_rough.inliers)
+          {
+            best_rough = std::move(rough);
+            best_start = p;
+          }
+        }
+      }
+    }
+    std::vector<bool> use = best_rough.inlier_mask;
+    for (std::size_t i = 0; i < readings.size(); ++i)
+    {
+      use[i] = use[i] && std::isfinite(readings[i].range);
+    }
+    if (countUsed(use) >= 3)
+    {
+      annealFrom(best_start, use);
     }
   }
   polishRounds();

@@ -25,6 +25,8 @@ double secondsSince(std::chrono::steady_clock::time_point start)
 
 /// Seeds of a level (in processing order) that may be retried from other voxels of their plateau.
 constexpr long kRetriedSeeds = 32;
+/// ... of which this many first get a local lattice search around their centroid.
+constexpr long kLocallySearchedSeeds = 8;
 }  // namespace
 
 void VoxelEngine::localizeComponentCentres(const std::vector<Reading>& readings, int min_inliers,
@@ -125,6 +127,7 @@ void VoxelEngine::localizeRobust(const std::vector<Reading>& readings, Result& r
     stage = std::chrono::steady_clock::now();
     RefinementSettings level_settings = settings;
     level_settings.escape_min_inliers = std::max(3, level - 1);
+    level_settings.target_inliers = level;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads()) if (maxima.size() >= 4)
     for (long c = 0; c < static_cast<long>(maxima.size()); ++c)
     {
@@ -148,6 +151,19 @@ void VoxelEngine::localizeRobust(const std::vector<Reading>& readings, Result& r
         Seed& seed = seeds[first + c];
         const VoxelCluster& cluster = maxima[c];
         const std::size_t n = cluster.voxels.size();
+        if (seed.candidate.inliers < level && c < kLocallySearchedSeeds)
+        {
+          // First the seed itself again, now with a local lattice search.
+          RefinementSettings search = level_settings;
+          search.local_search_cells = 2;
+          search.local_search_step = 0.5 * spec_.cell;
+          search.local_search_angle_step = 0.5 * spec_.thetaStep();
+          Candidate retry = refineSeed(*map_, cluster.centroid, readings, hypotheses[c], search);
+          if (betterCandidate(retry, seed.candidate))
+          {
+            seed.candidate = std::move(retry);
+          }
+        }
         for (std::size_t v : { cluster.representative, cluster.voxels[n / 3], cluster.voxels[(2 * n) / 3] })
         {
           if (seed.candidate.inliers >= level)

@@ -69,6 +69,13 @@ struct RefinementSettings
   int max_escapes = 3;                ///< leave-one-out rounds to escape a false minimum
   int escape_tries = 4;               ///< readings tried per leave-one-out round
   int escape_min_inliers = 3;         ///< only candidates with this many inliers try to escape
+  int target_inliers = 3;             ///< below this many inliers, try hypotheses without the
+                                      ///< readings most shortened at the seed (obstacle hits)
+  int max_dropped_shortened = 3;      ///< ... leaving out at most this many
+  int local_search_cells = 0;         ///< below target_inliers, also search (2m+1)^3 poses
+                                      ///< around the seed; 0 = no local search
+  double local_search_step = 0.05;    ///< lattice step of that search in x, y [m]
+  double local_search_angle_step = 0.02;  ///< ... and in theta [rad]
 };
 
 /**

@@ -225,7 +225,7 @@ TEST(ScenarioParsing, ShippedScenariosAreValid)
 {
   const std::string dir = std::string(FDML_SOURCE_DIR) + "/config/scenarios/";
   for (const char* name : { "paper_table1.yaml", "office_moving.yaml", "apartment.yaml", "square_noiseless.yaml",
-                            "warehouse_teleop.yaml" })
+                            "warehouse_teleop.yaml", "corridor_people.yaml" })
   {
     SCOPED_TRACE(name);
     core::ScenarioConfig c;

@@ -166,9 +166,10 @@ nav_msgs::OccupancyGrid toOccupancyGrid(const core::MapRayCaster& caster, double
     throw std::invalid_argument("occupancy grid resolution must be > 0");
   }
   const core::Box2& bounds = caster.map().bounds();
-  const core::Vec2 origin = bounds.min - core::Vec2(resolution, resolution);
-  const int width = static_cast<int>(std::ceil(bounds.size().x() / resolution)) + 2;
-  const int height = static_cast<int>(std::ceil(bounds.size().y() / resolution)) + 2;
+  // A margin of two cells, so the outer walls are surrounded by unknown cells.
+  const core::Vec2 origin = bounds.min - core::Vec2(2.0 * resolution, 2.0 * resolution);
+  const int width = static_cast<int>(std::ceil(bounds.size().x() / resolution)) + 4;
+  const int height = static_cast<int>(std::ceil(bounds.size().y() / resolution)) + 4;
   nav_msgs::OccupancyGrid grid;
   grid.header.frame_id = frame;
   grid.header.stamp = stamp;

@@ -11,6 +11,7 @@
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 #include <sensor_msgs/Range.h>
+#include <std_srvs/Empty.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 #include <visualization_msgs/MarkerArray.h>
@@ -142,7 +143,8 @@ TEST_F(Noiseless, EveryRangeEqualsAnIndependentRayCast)
   std::map<std::string, int> per_frame;
   int checked = 0;
   int misses = 0;
-  for (const auto& r : ranges_)
+  const std::vector<sensor_msgs::Range> ranges = ranges_;  // mount() spins: iterate over a copy
+  for (const auto& r : ranges)
   {
     auto gt = gt_.find(r.header.stamp);
     if (gt == gt_.end())
@@ -210,7 +212,7 @@ TEST_F(Noiseless, OdometryAgreesWithGroundTruth)
   EXPECT_NEAR(core::angleDiff(tf.theta, odom_.rbegin()->second.theta), 0.0, 1e-9);
 }
 
-TEST_F(Noiseless, KidnapMovesGroundTruthButNotOdometry)
+TEST_F(Noiseless, KidnapMovesGroundTruthButNotOdometryAndResetRestoresTheStart)
 {
   ros::ServiceClient client = nh_.serviceClient<fl::Kidnap>("/fdml_simulator/kidnap");
   ASSERT_TRUE(client.waitForExistence(ros::Duration(kWaitSeconds)));
@@ -258,6 +260,32 @@ TEST_F(Noiseless, KidnapMovesGroundTruthButNotOdometry)
   ASSERT_TRUE(client.call(random));
   EXPECT_TRUE(random.response.success) << random.response.message;
   EXPECT_TRUE(caster_->isFree(core::Vec2(random.response.pose.x, random.response.pose.y)));
+
+  // ~reset brings the robot back to its start (the first waypoint) and odometry to zero.
+  ros::ServiceClient reset = nh_.serviceClient<std_srvs::Empty>("/fdml_simulator/reset");
+  std_srvs::Empty empty;
+  ASSERT_TRUE(reset.call(empty));
+  const core::Pose2 start(1.0, 1.0, 0.0);
+  const std::size_t seen = gt_order_.size();
+  auto back_at_start = [&]() {
+    for (std::size_t i = seen; i < gt_order_.size(); ++i)
+    {
+      if ((gt_[gt_order_[i]].position() - start.position()).norm() < 0.05 && odom_.count(gt_order_[i]) > 0)
+      {
+        return true;
+      }
+    }
+    return false;
+  };
+  ASSERT_TRUE(waitFor(back_at_start));
+  for (std::size_t i = seen; i < gt_order_.size(); ++i)
+  {
+    if ((gt_[gt_order_[i]].position() - start.position()).norm() < 0.05 && odom_.count(gt_order_[i]) > 0)
+    {
+      EXPECT_LT(odom_[gt_order_[i]].position().norm(), 0.05);
+      break;
+    }
+  }
 }
 
 TEST_F(Obstacles, HitLabelsMatchIndependentCasts)
@@ -271,7 +299,8 @@ TEST_F(Obstacles, HitLabelsMatchIndependentCasts)
   }
   std::map<int, int> kinds;
   int checked = 0;
-  for (const auto& t : truths_)
+  const std::vector<fl::ReadingTruth> truths = truths_;  // mount() spins: iterate over a copy
+  for (const auto& t : truths)
   {
     auto gt = gt_.find(t.header.stamp);
     auto obstacles = obstacles_.find(t.header.stamp);

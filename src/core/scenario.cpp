@@ -360,6 +360,11 @@ std::vector<std::string> parseScenario(const ParamValue& root, ScenarioConfig* c
   {
     errors.push_back("sensors: at least one sensor (or an enabled scan) is needed");
   }
+  if (!config->publish_clock && config->time_scale != 1.0)
+  {
+    errors.push_back("time_scale: only used with publish_clock: true (wall time runs at 1x), got " +
+                     std::to_string(config->time_scale));
+  }
   auto check_rate = [&](const std::string& key, double rate) {
     if (rate > config->step_rate)
     {

@@ -221,6 +221,15 @@ odometry: {rate: 100}
   EXPECT_TRUE(anyErrorStartsWith(errors, "odometry.rate: must not exceed step_rate")) << joined(errors);
 }
 
+TEST(ScenarioParsing, TimeScaleNeedsTheClock)
+{
+  core::ScenarioConfig c;
+  auto errors = parse("{map_file: x.poly, time_scale: 4.0, sensors: [{frame: s}]}", &c);
+  EXPECT_TRUE(anyErrorStartsWith(errors, "time_scale: only used with publish_clock")) << joined(errors);
+  errors = parse("{map_file: x.poly, time_scale: 4.0, publish_clock: true, sensors: [{frame: s}]}", &c);
+  EXPECT_TRUE(errors.empty()) << joined(errors);
+}
+
 TEST(ScenarioParsing, ShippedScenariosAreValid)
 {
   const std::string dir = std::string(FDML_SOURCE_DIR) + "/config/scenarios/";

@@ -10,6 +10,8 @@
 #include <gtest/gtest.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
+#include <nav_msgs/OccupancyGrid.h>
+#include <sensor_msgs/LaserScan.h>
 #include <sensor_msgs/Range.h>
 #include <std_srvs/Empty.h>
 #include <tf2_ros/buffer.h>
@@ -43,6 +45,10 @@ protected:
     odom_sub_ = nh_.subscribe("odom", 10000, &SimulatorTest::onOdom, this);
     gt_sub_ = nh_.subscribe("ground_truth", 10000, &SimulatorTest::onGroundTruth, this);
     markers_sub_ = nh_.subscribe("obstacle_markers", 10000, &SimulatorTest::onMarkers, this);
+    scan_sub_ = nh_.subscribe<sensor_msgs::LaserScan>(
+        "scan", 1000, [this](const sensor_msgs::LaserScan::ConstPtr& msg) { scans_.push_back(*msg); });
+    grid_sub_ = nh_.subscribe<nav_msgs::OccupancyGrid>(
+        "map", 1, [this](const nav_msgs::OccupancyGrid::ConstPtr& msg) { grids_.push_back(*msg); });
     tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
     tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_);
   }
@@ -104,7 +110,9 @@ protected:
 
   ros::NodeHandle nh_;
   std::shared_ptr<core::MapRayCaster> caster_;
-  ros::Subscriber range_sub_, truth_sub_, odom_sub_, gt_sub_, markers_sub_;
+  ros::Subscriber range_sub_, truth_sub_, odom_sub_, gt_sub_, markers_sub_, scan_sub_, grid_sub_;
+  std::vector<sensor_msgs::LaserScan> scans_;
+  std::vector<nav_msgs::OccupancyGrid> grids_;
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
   std::map<std::string, core::Pose2> mounts_;
@@ -170,6 +178,49 @@ TEST_F(Noiseless, EveryRangeEqualsAnIndependentRayCast)
     EXPECT_NE(t.hit, fl::ReadingTruth::HIT_OBSTACLE);
     EXPECT_EQ(t.hit == fl::ReadingTruth::HIT_NONE, std::isinf(t.true_range));
   }
+}
+
+TEST_F(Noiseless, ScanBeamsEqualIndependentRayCasts)
+{
+  ASSERT_TRUE(waitFor([this]() { return scans_.size() >= 20; }));
+  const core::Pose2 mounting = mount("base_scan");
+  const std::vector<sensor_msgs::LaserScan> scans = scans_;
+  int checked = 0;
+  for (const auto& scan : scans)
+  {
+    auto gt = gt_.find(scan.header.stamp);
+    if (gt == gt_.end())
+    {
+      continue;
+    }
+    ASSERT_EQ(scan.ranges.size(), 12u);
+    const core::Pose2 base = core::compose(gt->second, mounting);
+    for (std::size_t b = 0; b < scan.ranges.size(); ++b)
+    {
+      const double angle = scan.angle_min + static_cast<double>(b) * scan.angle_increment;
+      const core::Pose2 beam = core::compose(base, core::Pose2(0.0, 0.0, angle));
+      expectRangeEq(scan.ranges[b], caster_->range(beam, scan.range_max), 1e-3, "beam " + std::to_string(b));
+    }
+    ++checked;
+  }
+  EXPECT_GE(checked, 15);
+}
+
+TEST_F(Noiseless, OccupancyGridMarksTheRobotCellFree)
+{
+  ASSERT_TRUE(waitFor([this]() { return !grids_.empty() && !gt_.empty(); }));
+  const nav_msgs::OccupancyGrid& grid = grids_.front();
+  EXPECT_EQ(grid.header.frame_id, "map");
+  EXPECT_NEAR(grid.info.resolution, 0.1, 1e-6);
+  auto cell = [&grid](double x, double y) {
+    const auto col = static_cast<std::size_t>((x - grid.info.origin.position.x) / grid.info.resolution);
+    const auto row = static_cast<std::size_t>((y - grid.info.origin.position.y) / grid.info.resolution);
+    return grid.data.at(row * grid.info.width + col);
+  };
+  const core::Pose2 robot = gt_.rbegin()->second;
+  EXPECT_EQ(cell(robot.x, robot.y), 0);
+  EXPECT_EQ(cell(3.75, 1.75), 100);  // the pillar
+  EXPECT_EQ(cell(1.0, 3.5), -1);     // outside the L
 }
 
 TEST_F(Noiseless, OdometryAgreesWithGroundTruth)

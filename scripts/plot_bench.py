@@ -23,7 +23,7 @@ HEADER = ["scene", "m", "n", "method", "trial", "success_paper", "success_strict
           "candidates", "time_ms", "sparsity_held", "err_pos", "err_theta"]
 METRICS = [("success_paper", "paper criterion", "-"), ("success_strict", "strict (5 cm, 2 deg)", "--"),
            ("success_top1", "top-1 strict", ":")]
-COLOURS = {"robust": "tab:blue", "robust-auto": "tab:purple", "paper": "tab:orange", "baseline": "tab:green"}
+COLOURS = {"robust": "tab:blue", "robust-k6": "tab:purple", "paper": "tab:orange", "baseline": "tab:green"}
 
 
 def read_rows(paths):

@@ -226,7 +226,7 @@ bool rangeToReading(const sensor_msgs::Range& msg, double received, TimedReading
     return false;
   }
   reading->frame_id = msg.header.frame_id;
-  reading->stamp = msg.header.stamp.toSec();
+  reading->stamp = static_cast<std::int64_t>(msg.header.stamp.toNSec());
   reading->beam = core::Pose2();
   reading->range = msg.range;
   reading->max_range = msg.max_range;
@@ -259,7 +259,8 @@ std::vector<TimedReading> scanToReadings(const sensor_msgs::LaserScan& msg, int 
     const std::size_t i = usable[j * usable.size() / n];
     TimedReading reading;
     reading.frame_id = msg.header.frame_id;
-    reading.stamp = msg.header.stamp.toSec() + static_cast<double>(i) * msg.time_increment;
+    reading.stamp = static_cast<std::int64_t>(msg.header.stamp.toNSec()) +
+                    std::llround(static_cast<double>(i) * msg.time_increment * 1e9);
     reading.beam = core::Pose2(0.0, 0.0, core::wrapAngle(msg.angle_min + static_cast<double>(i) * msg.angle_increment));
     reading.range = msg.ranges[i];
     reading.max_range = msg.range_max;

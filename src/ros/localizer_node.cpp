@@ -164,9 +164,10 @@ void LocalizerNode::scanCallback(const sensor_msgs::LaserScan::ConstPtr& msg)
   }
 }
 
-LookupStatus LocalizerNode::lookupInOdom(const std::string& frame, double stamp, core::Pose2* pose) const
+LookupStatus LocalizerNode::lookupInOdom(const std::string& frame, std::int64_t stamp, core::Pose2* pose) const
 {
-  const ros::Time time(stamp);
+  ros::Time time;
+  time.fromNSec(static_cast<std::uint64_t>(stamp));
   try
   {
     if (!tf_buffer_.canTransform(params_.odom_frame_id, frame, time))
@@ -197,7 +198,7 @@ void LocalizerNode::processTimer(const ros::WallTimerEvent& /*event*/)
   bool queued = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    const auto lookup = [this](const std::string& frame, double stamp, core::Pose2* pose) {
+    const auto lookup = [this](const std::string& frame, std::int64_t stamp, core::Pose2* pose) {
       return lookupInOdom(frame, stamp, pose);
     };
     dropped = buffer_.resolve(ros::Time::now().toSec(), params_.base_frame_id, lookup);

@@ -14,6 +14,16 @@
 
 namespace fdml_localization
 {
+namespace
+{
+ros::Time stampToTime(std::int64_t stamp)
+{
+  ros::Time time;
+  time.fromNSec(static_cast<std::uint64_t>(stamp));
+  return time;
+}
+}  // namespace
+
 bool isUnambiguous(const core::Result& result)
 {
   const auto& candidates = result.candidates;
@@ -59,7 +69,7 @@ LocalizerNode::Outcome LocalizerNode::solve(const Job& job)
 
   outcome.result = toResultMsg(result);
   outcome.result.header.frame_id = params_.global_frame_id;
-  outcome.result.header.stamp = job.from_sensors ? ros::Time(job.batch.newest_stamp) : ros::Time::now();
+  outcome.result.header.stamp = job.from_sensors ? stampToTime(job.batch.newest_stamp) : ros::Time::now();
   const bool unambiguous = solved && isUnambiguous(result);
   if (solved)
   {
@@ -113,7 +123,7 @@ LocalizerNode::Outcome LocalizerNode::solve(const Job& job)
 void LocalizerNode::publishBatchOutcome(const Job& job, const core::Result& result, const Outcome& outcome)
 {
   const Batch& batch = job.batch;
-  const ros::Time stamp(batch.newest_stamp);
+  const ros::Time stamp = stampToTime(batch.newest_stamp);
   result_pub_.publish(outcome.result);
 
   geometry_msgs::PoseArray candidates;

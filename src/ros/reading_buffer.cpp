@@ -18,7 +18,7 @@ bool ReadingBuffer::add(const TimedReading& reading, std::string* reason)
   {
     why = drop_reason::kEmptyFrameId;
   }
-  else if (!(std::isfinite(reading.stamp) && reading.stamp > 0.0))
+  else if (reading.stamp <= 0)
   {
     why = drop_reason::kZeroStamp;
   }

@@ -172,7 +172,7 @@ TEST(Conversions, RangeFollowsRep117)
   std::string reason;
   ASSERT_TRUE(rangeToReading(rangeMsg(2.0), 13.0, &reading, &reason));
   EXPECT_EQ(reading.frame_id, "sonar");
-  EXPECT_EQ(reading.stamp, 12.5);
+  EXPECT_EQ(reading.stamp, 12500000000);
   EXPECT_EQ(reading.range, 2.0);
   EXPECT_EQ(reading.max_range, 4.0);
   EXPECT_EQ(reading.received, 13.0);
@@ -237,7 +237,7 @@ TEST(Conversions, ScanTakesEvenlySpacedUsableBeams)
   {
     const int i = usable[j * usable.size() / readings.size()];
     EXPECT_EQ(readings[j].frame_id, "laser");
-    EXPECT_NEAR(readings[j].stamp, 100.0 + i * 0.001, 1e-6);
+    EXPECT_NEAR(static_cast<double>(readings[j].stamp), 100e9 + i * 1e6, 1e3);
     EXPECT_NEAR(core::angleDiff(readings[j].beam.theta, -core::kPi + i * core::kTwoPi / 360.0), 0.0, 1e-5);
     EXPECT_EQ(readings[j].range, i == 1 ? core::kInf : 3.0);
     EXPECT_EQ(readings[j].max_range, 10.0);

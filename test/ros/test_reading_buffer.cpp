@@ -10,6 +10,16 @@ namespace fdml_localization
 {
 namespace
 {
+std::int64_t nanoseconds(double seconds)
+{
+  return std::llround(seconds * 1e9);
+}
+
+double seconds(std::int64_t nanoseconds)
+{
+  return static_cast<double>(nanoseconds) * 1e-9;
+}
+
 /// A robot turning and driving in odom: base(t) = (1 + 0.2 t, 2 - 0.1 t, 0.5 + 0.8 t).
 core::Pose2 basePose(double t)
 {
@@ -30,9 +40,10 @@ struct FakeTf
   double available_after = 1e9;
   int calls = 0;
 
-  LookupStatus operator()(const std::string& frame, double stamp, core::Pose2* pose)
+  LookupStatus operator()(const std::string& frame, std::int64_t stamp_ns, core::Pose2* pose)
   {
     ++calls;
+    const double stamp = seconds(stamp_ns);
     if (frame == "base_link")
     {
       *pose = basePose(stamp);
@@ -60,7 +71,7 @@ TimedReading reading(const std::string& frame, double stamp, double range = 1.0)
 {
   TimedReading r;
   r.frame_id = frame;
-  r.stamp = stamp;
+  r.stamp = nanoseconds(stamp);
   r.range = range;
   r.max_range = 5.0;
   r.received = stamp;
@@ -122,8 +133,8 @@ TEST(ReadingBuffer, BatchOffsetsComeFromOdometryAndMountingAtEachStamp)
   Batch batch;
   ASSERT_TRUE(buffer.takeBatch(&batch));
   ASSERT_EQ(batch.readings.size(), 4u);
-  EXPECT_EQ(batch.first_stamp, 1.0);
-  EXPECT_EQ(batch.newest_stamp, 2.2);
+  EXPECT_EQ(batch.first_stamp, nanoseconds(1.0));
+  EXPECT_EQ(batch.newest_stamp, nanoseconds(2.2));
   expectPoseNear(batch.base_first, basePose(1.0));
   expectPoseNear(batch.base_newest, basePose(2.2));
   for (int i = 0; i < 4; ++i)
@@ -152,7 +163,7 @@ TEST(ReadingBuffer, ContinuousModeSlidesByTheStride)
   Batch batch;
   while (buffer.takeBatch(&batch))
   {
-    firsts.push_back(batch.first_stamp);
+    firsts.push_back(seconds(batch.first_stamp));
     EXPECT_EQ(batch.readings.size(), 3u);
   }
   // Windows [1..3], [3..5], [5..7].
@@ -184,8 +195,8 @@ TEST(ReadingBuffer, OnRequestModeSolvesOnceOnFreshReadings)
   }
   buffer.resolve(1.0, "base_link", std::ref(tf));
   ASSERT_TRUE(buffer.takeBatch(&batch));
-  EXPECT_NEAR(batch.first_stamp, 0.6, 1e-12);
-  EXPECT_NEAR(batch.newest_stamp, 0.8, 1e-12);
+  EXPECT_NEAR(seconds(batch.first_stamp), 0.6, 1e-12);
+  EXPECT_NEAR(seconds(batch.newest_stamp), 0.8, 1e-12);
   EXPECT_FALSE(buffer.batchRequested());
   EXPECT_FALSE(buffer.takeBatch(&batch));      // one batch per request
   EXPECT_EQ(buffer.dropped(), 0u);

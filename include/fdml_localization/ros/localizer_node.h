@@ -104,7 +104,7 @@ private:
   void rangeCallback(const sensor_msgs::Range::ConstPtr& msg);
   void scanCallback(const sensor_msgs::LaserScan::ConstPtr& msg);
   void processTimer(const ros::WallTimerEvent& event);
-  LookupStatus lookupInOdom(const std::string& frame, double stamp, core::Pose2* pose) const;
+  LookupStatus lookupInOdom(const std::string& frame, std::int64_t stamp, core::Pose2* pose) const;
   void warnDropped(const std::string& frame, const std::string& reason);
 
   // Services (localizer_node.cpp).

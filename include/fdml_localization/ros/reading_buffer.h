@@ -41,7 +41,7 @@ constexpr const char* kBufferOverflow = "buffer_overflow";         ///< too many
 struct TimedReading
 {
   std::string frame_id;    ///< sensor frame (the Range/LaserScan header frame)
-  double stamp = 0.0;      ///< acquisition time [s]
+  std::int64_t stamp = 0;  ///< acquisition time [ns] (integer, so tf lookups hit stamps exactly)
   core::Pose2 beam;        ///< the beam's pose in the sensor frame (a LaserScan beam: (0, 0, angle))
   double range = core::kInf;      ///< [m]; +inf = no return
   double max_range = core::kInf;  ///< [m]
@@ -65,18 +65,18 @@ enum class LookupStatus
 };
 
 /**
- * @brief Looks up the pose of @p frame in the odometry frame at @p stamp [s].
+ * @brief Looks up the pose of @p frame in the odometry frame at @p stamp [ns].
  *        Must not block (the node passes a zero tf timeout).
  */
-using PoseLookup = std::function<LookupStatus(const std::string& frame, double stamp, core::Pose2* pose)>;
+using PoseLookup = std::function<LookupStatus(const std::string& frame, std::int64_t stamp, core::Pose2* pose)>;
 
 /// A batch ready for the solver.
 struct Batch
 {
   std::vector<core::Reading> readings;   ///< g_i relative to the base at the first reading
   std::vector<ResolvedReading> sources;  ///< the same readings, with their odom poses
-  double first_stamp = 0.0;              ///< t_1 [s]
-  double newest_stamp = 0.0;             ///< the latest stamp in the batch [s]
+  std::int64_t first_stamp = 0;          ///< t_1 [ns]
+  std::int64_t newest_stamp = 0;         ///< the latest stamp in the batch [ns]
   core::Pose2 base_first;                ///< base in odom at t_1
   core::Pose2 base_newest;               ///< base in odom at newest_stamp
 };
@@ -147,7 +147,7 @@ private:
   Options options_;
   std::deque<TimedReading> pending_;      ///< waiting for transforms, arrival order
   std::deque<ResolvedReading> resolved_;  ///< ready, arrival order
-  std::map<std::string, double> last_stamp_;  ///< newest accepted stamp per frame [s]
+  std::map<std::string, std::int64_t> last_stamp_;  ///< newest accepted stamp per frame [ns]
   std::map<std::string, std::uint64_t> drops_;
   std::uint64_t received_ = 0;
   bool requested_ = false;

@@ -1,0 +1,118 @@
+#include "node_test_scene.h"
+
+#include "fdml_localization/core/map_io.h"
+#include "fdml_localization/ros/conversions.h"
+
+#include <geometry_msgs/TransformStamped.h>
+#include <sensor_msgs/Range.h>
+
+namespace fdml_localization
+{
+namespace test
+{
+std::string testMapPath()
+{
+  return std::string(FDML_SOURCE_DIR) + "/test/data/node_test_room.poly";
+}
+
+TurningScene::TurningScene() : map(std::make_shared<const core::MapRayCaster>(core::loadPolyFile(testMapPath())))
+{
+}
+
+core::Pose2 TurningScene::baseInMap(int j) const
+{
+  return core::Pose2(start.x, start.y, core::wrapAngle(start.theta + j * core::kTwoPi / k));
+}
+
+core::Pose2 TurningScene::baseInOdom(int j) const
+{
+  return core::compose(core::inverse(map_to_odom), baseInMap(j));
+}
+
+bool TurningScene::occluded(int j) const
+{
+  const int phase = ((j % k) + k) % k;
+  return phase == 3 || phase == 7;
+}
+
+double TurningScene::range(int j) const
+{
+  const double h = map->range(core::compose(baseInMap(j), mount), max_range);
+  return occluded(j) ? 0.5 * h : h;
+}
+
+std::vector<fdml_localization::Reading> TurningScene::readings(int first, int count) const
+{
+  std::vector<fdml_localization::Reading> out;
+  for (int j = first; j < first + count; ++j)
+  {
+    core::Reading reading;
+    reading.offset = core::compose(core::between(baseInMap(first), baseInMap(j)), mount);
+    reading.range = range(j);
+    reading.max_range = max_range;
+    out.push_back(toReadingMsg(reading));
+  }
+  return out;
+}
+
+ScenePublisher::ScenePublisher(ros::NodeHandle& nh, const TurningScene& scene)
+  : scene_(scene), range_pub_(nh.advertise<sensor_msgs::Range>("range", 100))
+{
+  geometry_msgs::TransformStamped mount;
+  mount.header.stamp = ros::Time::now();
+  mount.header.frame_id = "base_link";
+  mount.child_frame_id = "range_sensor";
+  mount.transform = toTransformMsg(scene_.mount);
+  static_broadcaster_.sendTransform(mount);
+}
+
+bool ScenePublisher::waitForSubscriber(double timeout)
+{
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout);
+  while (range_pub_.getNumSubscribers() == 0 && ros::WallTime::now() < deadline && ros::ok())
+  {
+    ros::WallDuration(0.01).sleep();
+  }
+  return range_pub_.getNumSubscribers() > 0;
+}
+
+ros::Time ScenePublisher::publishReading(int j)
+{
+  ros::Time stamp = ros::Time::now();
+  if (stamp <= last_stamp_)
+  {
+    stamp = last_stamp_ + ros::Duration(0, 1000);
+  }
+  last_stamp_ = stamp;
+  geometry_msgs::TransformStamped odom;
+  odom.header.stamp = stamp;
+  odom.header.frame_id = "odom";
+  odom.child_frame_id = "base_link";
+  odom.transform = toTransformMsg(scene_.baseInOdom(j));
+  broadcaster_.sendTransform(odom);
+  publishRange(scene_.range(j), "range_sensor", stamp);
+  index_of_stamp_[stamp] = j;
+  return stamp;
+}
+
+void ScenePublisher::publishRange(double range, const std::string& frame, const ros::Time& stamp)
+{
+  sensor_msgs::Range msg;
+  msg.header.stamp = stamp;
+  msg.header.frame_id = frame;
+  msg.radiation_type = sensor_msgs::Range::INFRARED;
+  msg.field_of_view = 0.01f;
+  msg.min_range = 0.02f;
+  msg.max_range = static_cast<float>(scene_.max_range);
+  msg.range = static_cast<float>(range);
+  range_pub_.publish(msg);
+}
+
+int ScenePublisher::indexOf(const ros::Time& stamp) const
+{
+  const auto it = index_of_stamp_.find(stamp);
+  return it == index_of_stamp_.end() ? -1 : it->second;
+}
+
+}  // namespace test
+}  // namespace fdml_localization

@@ -256,6 +256,8 @@ void LocalizerNode::startRelocalizationLocked(const OutcomePromise& waiter)
   {
     relocalize_waiters_.push_back(waiter);
   }
+  // The robot may have been kidnapped: stop vouching for the old map -> odom.
+  have_map_to_odom_ = false;
   state_ = "relocalizing: waiting for " + std::to_string(params_.measurements_per_batch) + " fresh readings";
 }
 

@@ -4,6 +4,7 @@
 #include "fdml_localization/ros/conversions.h"
 
 #include <geometry_msgs/TransformStamped.h>
+#include <sensor_msgs/LaserScan.h>
 #include <sensor_msgs/Range.h>
 
 namespace fdml_localization
@@ -56,27 +57,33 @@ std::vector<fdml_localization::Reading> TurningScene::readings(int first, int co
 }
 
 ScenePublisher::ScenePublisher(ros::NodeHandle& nh, const TurningScene& scene)
-  : scene_(scene), range_pub_(nh.advertise<sensor_msgs::Range>("range", 100))
+  : scene_(scene)
+  , range_pub_(nh.advertise<sensor_msgs::Range>("range", 100))
+  , scan_pub_(nh.advertise<sensor_msgs::LaserScan>("scan", 10))
 {
   geometry_msgs::TransformStamped mount;
   mount.header.stamp = ros::Time::now();
   mount.header.frame_id = "base_link";
   mount.child_frame_id = "range_sensor";
   mount.transform = toTransformMsg(scene_.mount);
-  static_broadcaster_.sendTransform(mount);
+  geometry_msgs::TransformStamped laser = mount;
+  laser.child_frame_id = "laser";
+  laser.transform = toTransformMsg(scene_.laser_mount);
+  static_broadcaster_.sendTransform(std::vector<geometry_msgs::TransformStamped>{ mount, laser });
 }
 
 bool ScenePublisher::waitForSubscriber(double timeout)
 {
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout);
-  while (range_pub_.getNumSubscribers() == 0 && ros::WallTime::now() < deadline && ros::ok())
+  const auto ready = [this]() { return range_pub_.getNumSubscribers() > 0 && scan_pub_.getNumSubscribers() > 0; };
+  while (!ready() && ros::WallTime::now() < deadline && ros::ok())
   {
     ros::WallDuration(0.01).sleep();
   }
-  return range_pub_.getNumSubscribers() > 0;
+  return ready();
 }
 
-ros::Time ScenePublisher::publishReading(int j)
+ros::Time ScenePublisher::nextStamp()
 {
   ros::Time stamp = ros::Time::now();
   if (stamp <= last_stamp_)
@@ -84,14 +91,48 @@ ros::Time ScenePublisher::publishReading(int j)
     stamp = last_stamp_ + ros::Duration(0, 1000);
   }
   last_stamp_ = stamp;
+  return stamp;
+}
+
+void ScenePublisher::publishOdom(int j, const ros::Time& stamp)
+{
   geometry_msgs::TransformStamped odom;
   odom.header.stamp = stamp;
   odom.header.frame_id = "odom";
   odom.child_frame_id = "base_link";
   odom.transform = toTransformMsg(scene_.baseInOdom(j));
   broadcaster_.sendTransform(odom);
-  publishRange(scene_.range(j), "range_sensor", stamp);
   index_of_stamp_[stamp] = j;
+}
+
+ros::Time ScenePublisher::publishReading(int j)
+{
+  const ros::Time stamp = nextStamp();
+  publishOdom(j, stamp);
+  publishRange(scene_.range(j), "range_sensor", stamp);
+  return stamp;
+}
+
+ros::Time ScenePublisher::publishScan(int j)
+{
+  const ros::Time stamp = nextStamp();
+  publishOdom(j, stamp);
+  sensor_msgs::LaserScan scan;
+  scan.header.stamp = stamp;
+  scan.header.frame_id = "laser";
+  scan.angle_min = static_cast<float>(-core::kPi);
+  scan.angle_increment = static_cast<float>(core::kTwoPi / 360.0);
+  scan.angle_max = static_cast<float>(-core::kPi + 359.0 * core::kTwoPi / 360.0);
+  scan.range_min = 0.02f;
+  scan.range_max = static_cast<float>(scene_.max_range);
+  const core::Pose2 laser = core::compose(scene_.baseInMap(j), scene_.laser_mount);
+  for (int i = 0; i < 360; ++i)
+  {
+    const double angle = scan.angle_min + i * static_cast<double>(scan.angle_increment);
+    const double range = scene_.map->range(core::compose(laser, core::Pose2(0.0, 0.0, angle)), scene_.max_range);
+    scan.ranges.push_back(static_cast<float>(range));
+  }
+  scan_pub_.publish(scan);
   return stamp;
 }
 

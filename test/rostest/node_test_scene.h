@@ -33,6 +33,7 @@ struct TurningScene
   core::Pose2 start{ 2.8, 1.2, 0.3 };        ///< base in the map at reading 0
   core::Pose2 map_to_odom{ 0.7, -0.4, 0.9 };  ///< the true map -> odom transform
   core::Pose2 mount{ 0.12, 0.03, 0.0 };       ///< base_link -> range_sensor
+  core::Pose2 laser_mount{ 0.05, -0.02, 0.0 };  ///< base_link -> laser
   int k = 10;                                 ///< readings per turn (2 pi / k apart)
   double max_range = 8.0;                     ///< [m]
 
@@ -53,10 +54,12 @@ class ScenePublisher
 public:
   ScenePublisher(ros::NodeHandle& nh, const TurningScene& scene);
 
-  /// Waits until the node subscribes to the range topic; false on timeout.
+  /// Waits until the node subscribes to the range and scan topics; false on timeout.
   bool waitForSubscriber(double timeout);
   /// Publishes odom -> base_link and the Range of reading j, stamped now; returns the stamp.
   ros::Time publishReading(int j);
+  /// Publishes odom -> base_link and a 360-beam LaserScan (no obstacle) at reading j's pose.
+  ros::Time publishScan(int j);
   /// Publishes a raw Range (for malformed input).
   void publishRange(double range, const std::string& frame, const ros::Time& stamp);
   /// The reading index published with @p stamp, -1 when unknown.
@@ -64,7 +67,11 @@ public:
 
 private:
   const TurningScene& scene_;
+  ros::Time nextStamp();
+  void publishOdom(int j, const ros::Time& stamp);
+
   ros::Publisher range_pub_;
+  ros::Publisher scan_pub_;
   tf2_ros::TransformBroadcaster broadcaster_;
   tf2_ros::StaticTransformBroadcaster static_broadcaster_;
   std::map<ros::Time, int> index_of_stamp_;

@@ -39,9 +39,9 @@ void expectWithinTolerance(const core::Pose2& estimate, const core::Pose2& truth
       << what << ": theta " << estimate.theta << " vs " << truth.theta;
 }
 
-/// Calls ~relocalize while publishing the turning robot's readings; returns the response.
+/// Calls ~relocalize while publishing the turning robot's readings (or scans); returns the response.
 bool relocalizeWhilePublishing(ros::NodeHandle& nh, ScenePublisher& publisher, int* next_index,
-                               fdml_localization::Relocalize::Response* response)
+                               fdml_localization::Relocalize::Response* response, bool scans = false)
 {
   ros::ServiceClient client = nh.serviceClient<fdml_localization::Relocalize>("fdml_localizer/relocalize");
   if (!client.waitForExistence(ros::Duration(60.0)))
@@ -59,7 +59,14 @@ bool relocalizeWhilePublishing(ros::NodeHandle& nh, ScenePublisher& publisher, i
   const int limit = *next_index + 2000;
   while (call.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready && *next_index < limit)
   {
-    publisher.publishReading((*next_index)++);
+    if (scans)
+    {
+      publisher.publishScan((*next_index)++);
+    }
+    else
+    {
+      publisher.publishReading((*next_index)++);
+    }
   }
   const auto outcome = call.get();
   *response = outcome.second;
@@ -221,6 +228,25 @@ TEST(LocalizerNode, LocalizeOnExplicitReadings)
   ASSERT_TRUE(client.call(nan));
   EXPECT_FALSE(nan.response.success);
   EXPECT_FALSE(nan.response.message.empty());
+}
+
+TEST(LocalizerNode, RelocalizeFromOneLaserScan)
+{
+  ros::NodeHandle nh;
+  TurningScene scene;
+  ScenePublisher publisher(nh, scene);
+  ASSERT_TRUE(publisher.waitForSubscriber(30.0));
+  int next_index = 1000;
+  fdml_localization::Relocalize::Response response;
+  ASSERT_TRUE(relocalizeWhilePublishing(nh, publisher, &next_index, &response, true));
+  EXPECT_TRUE(response.success) << response.message;
+  // ~beams_per_scan (10) beams of one scan make the batch: every beam is stamped with the scan.
+  const int index = publisher.indexOf(response.result.header.stamp);
+  ASSERT_GE(index, 1000);
+  ASSERT_FALSE(response.result.candidates.empty()) << response.message;
+  const auto& best = response.result.candidates.front();
+  expectWithinTolerance(fromPoseMsg(best.pose), scene.baseInMap(index), "best candidate from a scan");
+  EXPECT_EQ(best.inliers, 10u);
 }
 
 TEST(LocalizerNode, MalformedInputIsCountedAndTheNodeStillLocalizes)

@@ -14,7 +14,8 @@
  * Relocalization (~relocalize, global_localization) clears the buffer and waits for k fresh
  * readings, each taken at its own stamp: the readings must differ, so the robot must rotate
  * in place (or drive) or the sensors must sweep while it waits. The readings' relative poses
- * come from odometry and the sensors' mounting on tf.
+ * come from odometry and the sensors' mounting on tf. map -> odom is not published from the
+ * request until the next unambiguous answer.
  *
  * ~pose and map -> odom are published only when the best candidate is unambiguous: there is
  * exactly one candidate, or the best explains strictly more readings than the second

@@ -24,7 +24,7 @@ double quaternionToYaw(const geometry_msgs::Quaternion& q)
   const double siny = 2.0 * (q.w * q.z + q.x * q.y);
   // Homogeneous form: also right for a quaternion that is not normalised.
   const double cosy = q.w * q.w + q.x * q.x - q.y * q.y - q.z * q.z;
-  if (siny == 0.0 && cosy == 0.0)
+  if ((siny == 0.0 && cosy == 0.0) || !std::isfinite(siny) || !std::isfinite(cosy))
   {
     return 0.0;
   }
@@ -46,7 +46,7 @@ core::Pose2 fromPoseMsg(const geometry_msgs::Pose& pose)
   return core::Pose2(pose.position.x, pose.position.y, quaternionToYaw(pose.orientation));
 }
 
-geometry_msgs::Pose2D toPose2DMsg(const core::Pose2& pose)
+geometry_msgs::Pose2D toPose2D(const core::Pose2& pose)
 {
   geometry_msgs::Pose2D msg;
   msg.x = pose.x;
@@ -55,7 +55,7 @@ geometry_msgs::Pose2D toPose2DMsg(const core::Pose2& pose)
   return msg;
 }
 
-core::Pose2 fromPose2DMsg(const geometry_msgs::Pose2D& pose)
+core::Pose2 fromPose2D(const geometry_msgs::Pose2D& pose)
 {
   return core::Pose2(pose.x, pose.y, pose.theta);
 }
@@ -107,7 +107,7 @@ Eigen::Matrix3d fromCovariance6(const boost::array<double, 36>& covariance)
 fdml_localization::Reading toReadingMsg(const core::Reading& reading)
 {
   fdml_localization::Reading msg;
-  msg.sensor_offset = toPose2DMsg(reading.offset);
+  msg.sensor_offset = toPose2D(reading.offset);
   msg.range = reading.range;
   msg.max_range = reading.max_range;
   return msg;
@@ -116,7 +116,7 @@ fdml_localization::Reading toReadingMsg(const core::Reading& reading)
 core::Reading fromReadingMsg(const fdml_localization::Reading& msg)
 {
   core::Reading reading;
-  reading.offset = fromPose2DMsg(msg.sensor_offset);
+  reading.offset = fromPose2D(msg.sensor_offset);
   reading.range = msg.range;
   reading.max_range = msg.max_range;
   return reading;

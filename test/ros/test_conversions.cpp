@@ -46,6 +46,9 @@ TEST(Conversions, YawQuaternionRoundTripAndAxis)
   scaled.w *= 3.0;
   EXPECT_NEAR(quaternionToYaw(scaled), 0.7, 1e-12);
   EXPECT_EQ(quaternionToYaw(geometry_msgs::Quaternion()), 0.0);
+  geometry_msgs::Quaternion broken;
+  broken.w = kNan;
+  EXPECT_EQ(quaternionToYaw(broken), 0.0);
 }
 
 TEST(Conversions, PoseMessagesRoundTrip)
@@ -55,7 +58,7 @@ TEST(Conversions, PoseMessagesRoundTrip)
   {
     const core::Pose2 pose = randomPose(rng);
     expectPoseNear(fromPoseMsg(toPoseMsg(pose)), pose);
-    expectPoseNear(fromPose2DMsg(toPose2DMsg(pose)), pose);
+    expectPoseNear(fromPose2D(toPose2D(pose)), pose);
     expectPoseNear(fromTransformMsg(toTransformMsg(pose)), pose);
     EXPECT_EQ(toPoseMsg(pose).position.z, 0.0);
   }

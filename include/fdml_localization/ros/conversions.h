@@ -35,13 +35,14 @@ namespace fdml_localization
 
 /// Quaternion of a rotation by @p yaw [rad] about +z.
 geometry_msgs::Quaternion yawToQuaternion(double yaw);
-/// Yaw [rad] in [-pi, pi) of a quaternion (its rotation projected on the plane); 0 for a zero quaternion.
+/// Yaw [rad] in [-pi, pi) of a quaternion (its rotation projected on the plane, normalised or not);
+/// a zero or non-finite quaternion gives 0.
 double quaternionToYaw(const geometry_msgs::Quaternion& q);
 
 geometry_msgs::Pose toPoseMsg(const core::Pose2& pose);
 core::Pose2 fromPoseMsg(const geometry_msgs::Pose& pose);
-geometry_msgs::Pose2D toPose2DMsg(const core::Pose2& pose);
-core::Pose2 fromPose2DMsg(const geometry_msgs::Pose2D& pose);
+geometry_msgs::Pose2D toPose2D(const core::Pose2& pose);
+core::Pose2 fromPose2D(const geometry_msgs::Pose2D& pose);
 geometry_msgs::Transform toTransformMsg(const core::Pose2& pose);
 core::Pose2 fromTransformMsg(const geometry_msgs::Transform& transform);
 

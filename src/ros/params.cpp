@@ -68,7 +68,7 @@ std::vector<std::string> validate(const Params& p)
     errors.push_back("~map_file is required: a .poly path, absolute or package://fdml_localization/maps/...");
   }
   const int k = p.measurements_per_batch;
-  check(&errors, k >= 3 && k <= 1000, "measurements_per_batch", k, "an integer in [3, 1000]");
+  check(&errors, k >= 3 && k <= 255, "measurements_per_batch", k, "an integer in [3, 255]");
   check(&errors, p.batch_stride >= 1 && p.batch_stride <= std::max(k, 1), "batch_stride", p.batch_stride,
         "an integer in [1, ~measurements_per_batch]");
   SolveMode mode;
@@ -97,10 +97,12 @@ std::vector<std::string> validate(const Params& p)
   check(&errors, p.method == "robust" || p.method == "paper" || p.method == "baseline", "method", quoted(p.method),
         "\"robust\", \"paper\" or \"baseline\"");
   check(&errors, p.resolution >= 16 && p.resolution <= 1024, "resolution", p.resolution, "an integer in [16, 1024]");
-  check(&errors, p.theta_resolution == 0 || (p.theta_resolution >= 8 && p.theta_resolution <= 1024),
-        "theta_resolution", p.theta_resolution, "0 (= ~resolution) or an integer in [8, 1024]");
+  check(&errors, p.theta_resolution == 0 || (p.theta_resolution >= 16 && p.theta_resolution <= 1024),
+        "theta_resolution", p.theta_resolution, "0 (= ~resolution) or an integer in [16, 1024]");
   check(&errors, p.min_inliers == 0 || (p.min_inliers >= 3 && p.min_inliers <= k), "min_inliers", p.min_inliers,
         "0 (automatic) or an integer in [3, ~measurements_per_batch]");
+  check(&errors, p.method != "paper" || p.min_inliers != 0, "min_inliers", p.min_inliers,
+        "a fixed k' in [3, ~measurements_per_batch] with ~method paper (automatic k' is not the paper's)");
   check(&errors, finiteIn(p.agreement_tolerance, 0.0, 10.0) && p.agreement_tolerance > 0.0, "agreement_tolerance",
         p.agreement_tolerance, "(0, 10] m");
   check(&errors, finiteIn(p.uniqueness_distance, 0.0, 100.0), "uniqueness_distance", p.uniqueness_distance,

@@ -51,7 +51,8 @@ TEST(Params, EachOutOfRangeValueNamesItsParameterAndRange)
     const char* range;
   };
   const std::vector<Case> cases = {
-    { "measurements_per_batch", [](Params& p) { p.measurements_per_batch = 2; }, "[3, 1000]" },
+    { "measurements_per_batch", [](Params& p) { p.measurements_per_batch = 2; }, "[3, 255]" },
+    { "measurements_per_batch", [](Params& p) { p.measurements_per_batch = 256; }, "[3, 255]" },
     { "batch_stride", [](Params& p) { p.batch_stride = 11; }, "[1, ~measurements_per_batch]" },
     { "batch_stride", [](Params& p) { p.batch_stride = 0; }, "[1, ~measurements_per_batch]" },
     { "mode", [](Params& p) { p.mode = "sometimes"; }, "\"on_request\" or \"continuous\"" },
@@ -68,9 +69,10 @@ TEST(Params, EachOutOfRangeValueNamesItsParameterAndRange)
     { "method", [](Params& p) { p.method = "magic"; }, "\"robust\", \"paper\" or \"baseline\"" },
     { "resolution", [](Params& p) { p.resolution = 15; }, "[16, 1024]" },
     { "resolution", [](Params& p) { p.resolution = 1025; }, "[16, 1024]" },
-    { "theta_resolution", [](Params& p) { p.theta_resolution = 4; }, "[8, 1024]" },
+    { "theta_resolution", [](Params& p) { p.theta_resolution = 15; }, "[16, 1024]" },
     { "min_inliers", [](Params& p) { p.min_inliers = 2; }, "[3, ~measurements_per_batch]" },
     { "min_inliers", [](Params& p) { p.min_inliers = 11; }, "[3, ~measurements_per_batch]" },
+    { "min_inliers", [](Params& p) { p.method = "paper"; }, "with ~method paper" },
     { "agreement_tolerance", [](Params& p) { p.agreement_tolerance = 0.0; }, "(0, 10] m" },
     { "uniqueness_distance", [](Params& p) { p.uniqueness_distance = -1.0; }, "[0, 100] m" },
     { "uniqueness_angle", [](Params& p) { p.uniqueness_angle = 4.0; }, "[0, pi] rad" },
@@ -120,6 +122,10 @@ TEST(Params, LimitsAreInclusive)
   params.min_inliers = 3;
   params.resolution = 16;
   params.theta_resolution = 1024;
+  params.measurements_per_batch = 255;
+  EXPECT_TRUE(validate(params).empty());
+  params.measurements_per_batch = 3;
+  params.theta_resolution = 16;
   params.transform_tolerance = 0.0;
   params.mode = "continuous";
   EXPECT_TRUE(validate(params).empty());

@@ -33,7 +33,7 @@ struct Params
 {
   // Map and batching.
   std::string map_file;              ///< ~map_file: .poly path, absolute or package://...; required
-  int measurements_per_batch = 10;   ///< ~measurements_per_batch: k, in [3, 1000]
+  int measurements_per_batch = 10;   ///< ~measurements_per_batch: k, in [3, 255]
   int batch_stride = 1;              ///< ~batch_stride: readings the window slides by, in [1, k]
   std::string mode = "on_request";   ///< ~mode: on_request | continuous
   int beams_per_scan = 10;           ///< ~beams_per_scan: readings taken from a LaserScan, [1, 1000]
@@ -55,8 +55,8 @@ struct Params
   std::string engine = "voxel";      ///< ~engine: voxel | adaptive
   std::string method = "robust";     ///< ~method: robust | paper | baseline
   int resolution = 100;              ///< ~resolution
-  int theta_resolution = 0;          ///< ~theta_resolution; 0 = resolution
-  int min_inliers = 0;               ///< ~min_inliers: k', 0 = automatic, else in [3, k]
+  int theta_resolution = 0;          ///< ~theta_resolution: 0 = resolution, else in [16, 1024]
+  int min_inliers = 0;               ///< ~min_inliers: k', 0 = automatic, else in [3, k] (fixed for paper)
   double agreement_tolerance = 0.05; ///< ~agreement_tolerance [m]
   double uniqueness_distance = 0.1;  ///< ~uniqueness_distance [m]
   double uniqueness_angle = 0.1;     ///< ~uniqueness_angle [rad]

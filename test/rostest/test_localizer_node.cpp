@@ -9,6 +9,7 @@
 #include <fdml_localization/Localize.h>
 #include <fdml_localization/Relocalize.h>
 #include <geometry_msgs/PoseArray.h>
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <std_srvs/Empty.h>
@@ -247,6 +248,44 @@ TEST(LocalizerNode, RelocalizeFromOneLaserScan)
   const auto& best = response.result.candidates.front();
   expectWithinTolerance(fromPoseMsg(best.pose), scene.baseInMap(index), "best candidate from a scan");
   EXPECT_EQ(best.inliers, 10u);
+}
+
+TEST(LocalizerNode, ContinuousModeSolvesEveryBatchAndPublishesThePose)
+{
+  ros::NodeHandle nh;
+  TurningScene scene;
+  ScenePublisher publisher(nh, scene);
+  ASSERT_TRUE(publisher.waitForSubscriber(30.0));
+  Collector<fdml_localization::LocalizationResult> results(nh, "fdml_localizer_continuous/result");
+  Collector<geometry_msgs::PoseWithCovarianceStamped> poses(nh, "fdml_localizer_continuous/pose");
+
+  // Publish until a result of a batch made only of this test's readings (indices >= 2000) arrives:
+  // with a stride of k, a batch ending at 2000 + k - 1 or later holds none of the earlier tests'.
+  int next_index = 2000;
+  fdml_localization::LocalizationResult result;
+  const auto complete = [&publisher, &scene](const fdml_localization::LocalizationResult& msg) {
+    return publisher.indexOf(msg.header.stamp) >= 2000 + scene.k - 1;
+  };
+  while (next_index < 2400 && !results.waitFor(complete, 0.05, &result))
+  {
+    publisher.publishReading(next_index++);
+  }
+  const int last = publisher.indexOf(result.header.stamp);
+  ASSERT_GE(last, 2000 + scene.k - 1) << "no result for the published readings";
+  ASSERT_FALSE(result.candidates.empty());
+  const int first = last - (scene.k - 1);
+  expectWithinTolerance(fromPoseMsg(result.candidates.front().pose), scene.baseInMap(first),
+                        "continuous best candidate");
+
+  // ~pose: the best, carried forward to the newest reading, with a positive covariance.
+  geometry_msgs::PoseWithCovarianceStamped pose;
+  ASSERT_TRUE(poses.waitFor(
+      [&result](const geometry_msgs::PoseWithCovarianceStamped& msg) { return msg.header.stamp == result.header.stamp; },
+      10.0, &pose));
+  expectWithinTolerance(fromPoseMsg(pose.pose.pose), scene.baseInMap(last), "~pose");
+  EXPECT_GT(pose.pose.covariance[0], 0.0);
+  EXPECT_GT(pose.pose.covariance[7], 0.0);
+  EXPECT_GT(pose.pose.covariance[35], 0.0);
 }
 
 TEST(LocalizerNode, MalformedInputIsCountedAndTheNodeStillLocalizes)

@@ -62,14 +62,15 @@ LocalizerNode::LocalizerNode(const ros::NodeHandle& nh, const ros::NodeHandle& p
                                     this);
   }
 
-  worker_ = std::thread(&LocalizerNode::workerLoop, this);
-
   relocalize_srv_ = service_nh_.advertiseService("relocalize", &LocalizerNode::relocalizeService, this);
   localize_srv_ = service_nh_.advertiseService("localize", &LocalizerNode::localizeService, this);
   global_localization_srv_ =
       global_service_nh_.advertiseService("global_localization", &LocalizerNode::globalLocalizationService, this);
   service_spinner_.reset(new ros::AsyncSpinner(2, &service_queue_));
   service_spinner_->start();
+
+  // Last: nothing below can throw, so a started worker is always joined by the destructor.
+  worker_ = std::thread(&LocalizerNode::workerLoop, this);
 }
 
 LocalizerNode::~LocalizerNode()
@@ -207,6 +208,7 @@ void LocalizerNode::processTimer(const ros::WallTimerEvent& /*event*/)
     {
       std::unique_ptr<Job> job(new Job);
       job->from_sensors = true;
+      job->generation = relocalization_generation_;
       job->readings = batch.readings;
       job->batch = std::move(batch);
       job->waiters.swap(relocalize_waiters_);
@@ -256,15 +258,18 @@ void LocalizerNode::startRelocalizationLocked(const OutcomePromise& waiter)
   {
     relocalize_waiters_.push_back(waiter);
   }
-  // The robot may have been kidnapped: stop vouching for the old map -> odom.
+  // The robot may have been kidnapped: stop vouching for the old map -> odom, and let no batch
+  // formed before this request (perhaps being solved right now) bring it back.
   have_map_to_odom_ = false;
+  ++relocalization_generation_;
   state_ = "relocalizing: waiting for " + std::to_string(params_.measurements_per_batch) + " fresh readings";
 }
 
 bool LocalizerNode::relocalizeService(fdml_localization::Relocalize::Request& req,
                                       fdml_localization::Relocalize::Response& res)
 {
-  double timeout = req.timeout > 0.0 && std::isfinite(req.timeout) ? req.timeout : params_.relocalize_timeout;
+  const double timeout =
+      req.timeout > 0.0 && std::isfinite(req.timeout) ? req.timeout : params_.relocalize_timeout;
   auto waiter = std::make_shared<std::promise<Outcome>>();
   std::future<Outcome> future = waiter->get_future();
   {

@@ -103,7 +103,7 @@ LocalizerNode::Outcome LocalizerNode::solve(const Job& job)
         ++solve_errors_;
         last_error_ = outcome.message;
       }
-      if (unambiguous)
+      if (unambiguous && job.generation == relocalization_generation_)
       {
         have_map_to_odom_ = true;
         map_to_odom_ = core::compose(result.candidates[0].pose, core::inverse(job.batch.base_first));

@@ -72,10 +72,12 @@ ScenePublisher::ScenePublisher(ros::NodeHandle& nh, const TurningScene& scene)
   static_broadcaster_.sendTransform(std::vector<geometry_msgs::TransformStamped>{ mount, laser });
 }
 
-bool ScenePublisher::waitForSubscriber(double timeout)
+bool ScenePublisher::waitForSubscribers(std::uint32_t nodes, double timeout)
 {
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout);
-  const auto ready = [this]() { return range_pub_.getNumSubscribers() > 0 && scan_pub_.getNumSubscribers() > 0; };
+  const auto ready = [this, nodes]() {
+    return range_pub_.getNumSubscribers() >= nodes && scan_pub_.getNumSubscribers() >= nodes;
+  };
   while (!ready() && ros::WallTime::now() < deadline && ros::ok())
   {
     ros::WallDuration(0.01).sleep();

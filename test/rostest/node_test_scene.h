@@ -54,8 +54,9 @@ class ScenePublisher
 public:
   ScenePublisher(ros::NodeHandle& nh, const TurningScene& scene);
 
-  /// Waits until the node subscribes to the range and scan topics; false on timeout.
-  bool waitForSubscriber(double timeout);
+  /// Waits until @p nodes subscribers are connected to both the range and the scan topic
+  /// (messages published earlier would be lost for the late ones); false on timeout.
+  bool waitForSubscribers(std::uint32_t nodes, double timeout);
   /// Publishes odom -> base_link and the Range of reading j, stamped now; returns the stamp.
   ros::Time publishReading(int j);
   /// Publishes odom -> base_link and a 360-beam LaserScan (no obstacle) at reading j's pose.

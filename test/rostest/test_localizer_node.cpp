@@ -31,6 +31,7 @@ namespace
 {
 constexpr double kPositionTolerance = 0.05;                 // [m]
 constexpr double kAngleTolerance = 2.0 * core::kPi / 180.0;  // [rad]
+constexpr std::uint32_t kLocalizerNodes = 2;                 // localizer_node.test starts two
 
 void expectWithinTolerance(const core::Pose2& estimate, const core::Pose2& truth, const std::string& what)
 {
@@ -160,7 +161,7 @@ TEST(LocalizerNode, RelocalizeWhileTurningInPlaceFlagsTheOccludedReadings)
   ros::NodeHandle nh;
   TurningScene scene;
   ScenePublisher publisher(nh, scene);
-  ASSERT_TRUE(publisher.waitForSubscriber(30.0));
+  ASSERT_TRUE(publisher.waitForSubscribers(kLocalizerNodes, 30.0));
   Collector<geometry_msgs::PoseArray> candidates(nh, "fdml_localizer/candidates");
   tf2_ros::Buffer tf_buffer;
   tf2_ros::TransformListener tf_listener(tf_buffer);
@@ -218,6 +219,15 @@ TEST(LocalizerNode, LocalizeOnExplicitReadings)
     }
   }
 
+  // ~relocalize without readings times out with a message that says what to do.
+  ros::ServiceClient relocalize = nh.serviceClient<fdml_localization::Relocalize>("fdml_localizer/relocalize");
+  fdml_localization::Relocalize timed_out;
+  timed_out.request.timeout = 0.3;
+  ASSERT_TRUE(relocalize.call(timed_out));
+  EXPECT_FALSE(timed_out.response.success);
+  EXPECT_NE(timed_out.response.message.find("timed out"), std::string::npos) << timed_out.response.message;
+  EXPECT_NE(timed_out.response.message.find("rotates in place"), std::string::npos) << timed_out.response.message;
+
   // Unusable requests fail with a message instead of killing the node.
   fdml_localization::Localize empty;
   ASSERT_TRUE(client.call(empty));
@@ -236,7 +246,7 @@ TEST(LocalizerNode, RelocalizeFromOneLaserScan)
   ros::NodeHandle nh;
   TurningScene scene;
   ScenePublisher publisher(nh, scene);
-  ASSERT_TRUE(publisher.waitForSubscriber(30.0));
+  ASSERT_TRUE(publisher.waitForSubscribers(kLocalizerNodes, 30.0));
   int next_index = 1000;
   fdml_localization::Relocalize::Response response;
   ASSERT_TRUE(relocalizeWhilePublishing(nh, publisher, &next_index, &response, true));
@@ -255,7 +265,7 @@ TEST(LocalizerNode, ContinuousModeSolvesEveryBatchAndPublishesThePose)
   ros::NodeHandle nh;
   TurningScene scene;
   ScenePublisher publisher(nh, scene);
-  ASSERT_TRUE(publisher.waitForSubscriber(30.0));
+  ASSERT_TRUE(publisher.waitForSubscribers(kLocalizerNodes, 30.0));
   Collector<fdml_localization::LocalizationResult> results(nh, "fdml_localizer_continuous/result");
   Collector<geometry_msgs::PoseWithCovarianceStamped> poses(nh, "fdml_localizer_continuous/pose");
 
@@ -293,7 +303,7 @@ TEST(LocalizerNode, MalformedInputIsCountedAndTheNodeStillLocalizes)
   ros::NodeHandle nh;
   TurningScene scene;
   ScenePublisher publisher(nh, scene);
-  ASSERT_TRUE(publisher.waitForSubscriber(30.0));
+  ASSERT_TRUE(publisher.waitForSubscribers(kLocalizerNodes, 30.0));
   Collector<diagnostic_msgs::DiagnosticArray> diagnostics(nh, "/diagnostics");
 
   const double nan = std::numeric_limits<double>::quiet_NaN();

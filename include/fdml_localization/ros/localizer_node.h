@@ -98,6 +98,7 @@ private:
     std::vector<core::Reading> readings;
     bool from_sensors = false;  ///< true: a tf batch (published); false: a ~localize request
     Batch batch;                ///< from_sensors only
+    std::uint64_t generation = 0;  ///< relocalization_generation_ when the batch was formed
     std::vector<OutcomePromise> waiters;
   };
 
@@ -165,6 +166,7 @@ private:
   std::deque<Job> queued_requests_;     ///< ~localize requests, FIFO
   std::vector<OutcomePromise> relocalize_waiters_;  ///< for the next sensor batch
   bool shutting_down_ = false;
+  std::uint64_t relocalization_generation_ = 0;  ///< bumped by every relocalization request
   bool have_map_to_odom_ = false;
   core::Pose2 map_to_odom_;             ///< last unambiguous map -> odom
   std::uint64_t batches_solved_ = 0;

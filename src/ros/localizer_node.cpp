@@ -45,7 +45,7 @@ LocalizerNode::LocalizerNode(const ros::NodeHandle& nh, const ros::NodeHandle& p
   candidates_pub_ = private_nh_.advertise<geometry_msgs::PoseArray>("candidates", 1, true);
   result_pub_ = private_nh_.advertise<fdml_localization::LocalizationResult>("result", 1, true);
   pose_pub_ = private_nh_.advertise<geometry_msgs::PoseWithCovarianceStamped>("pose", 1, true);
-  map_markers_pub_ = private_nh_.advertise<visualization_msgs::Marker>("map_markers", 1, true);
+  map_markers_pub_ = private_nh_.advertise<visualization_msgs::MarkerArray>("map_markers", 1, true);
   reading_markers_pub_ = private_nh_.advertise<visualization_msgs::MarkerArray>("reading_markers", 1, true);
   publishMapMarkers();
 

@@ -190,9 +190,7 @@ void LocalizerNode::publishMapToOdom(const ros::WallTimerEvent& /*event*/)
 
 void LocalizerNode::publishMapMarkers()
 {
-  visualization_msgs::Marker marker = mapMarker(map_->map(), params_.global_frame_id);
-  marker.header.stamp = ros::Time::now();
-  map_markers_pub_.publish(marker);
+  map_markers_pub_.publish(mapMarkers(map_->map(), params_.global_frame_id, ros::Time::now()));
 }
 
 void LocalizerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)

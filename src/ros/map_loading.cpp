@@ -1,8 +1,7 @@
 #include "fdml_localization/ros/map_loading.h"
 
 #include "fdml_localization/core/map_io.h"
-
-#include <ros/package.h>
+#include "fdml_localization/ros/param_utils.h"
 
 #include <fstream>
 
@@ -10,30 +9,13 @@ namespace fdml_localization
 {
 std::string resolveMapPath(const std::string& location)
 {
-  const std::string package_scheme = "package://";
-  const std::string file_scheme = "file://";
-  if (location.compare(0, file_scheme.size(), file_scheme) == 0)
+  std::string error;
+  const std::string path = resolveResourcePath(location, &error);
+  if (!error.empty())
   {
-    return location.substr(file_scheme.size());
+    throw MapLoadError("~map_file \"" + location + "\": " + error);
   }
-  if (location.compare(0, package_scheme.size(), package_scheme) != 0)
-  {
-    return location;
-  }
-  const std::string rest = location.substr(package_scheme.size());
-  const std::size_t slash = rest.find('/');
-  if (slash == std::string::npos || slash == 0 || slash + 1 >= rest.size())
-  {
-    throw MapLoadError("~map_file \"" + location + "\": expected package://PACKAGE/relative/path");
-  }
-  const std::string package = rest.substr(0, slash);
-  const std::string package_path = ros::package::getPath(package);
-  if (package_path.empty())
-  {
-    throw MapLoadError("~map_file \"" + location + "\": package \"" + package +
-                       "\" not found on ROS_PACKAGE_PATH (source the workspace's setup.bash)");
-  }
-  return package_path + "/" + rest.substr(slash + 1);
+  return path;
 }
 
 std::shared_ptr<const core::MapRayCaster> loadMap(const std::string& location)

@@ -1,11 +1,135 @@
-// Message conversions: round trips and REP-117 semantics (no roscore).
+// Tests of the ROS conversion helpers and parameter utilities (no roscore needed): the
+// simulator's, then the localizer node's (round trips and REP-117 semantics).
 #include "fdml_localization/ros/conversions.h"
+#include "fdml_localization/ros/param_utils.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
-#include <random>
+
+namespace core = fdml_localization::core;
+namespace fl = fdml_localization;
+using core::Vec2;
+
+TEST(Conversions, YawQuaternionRoundTrip)
+{
+  for (double yaw = -3.1; yaw < 3.14; yaw += 0.37)
+  {
+    const geometry_msgs::Quaternion q = fl::yawToQuaternion(yaw);
+    EXPECT_NEAR(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w, 1.0, 1e-12);
+    EXPECT_NEAR(fl::quaternionToYaw(q), yaw, 1e-12);
+  }
+  // A rotation of pi about +z given with w < 0 is the same yaw.
+  geometry_msgs::Quaternion q;
+  q.z = -1.0;
+  q.w = 0.0;
+  EXPECT_NEAR(std::abs(fl::quaternionToYaw(q)), core::kPi, 1e-12);
+  geometry_msgs::Quaternion zero;
+  zero.w = 0.0;
+  EXPECT_EQ(fl::quaternionToYaw(zero), 0.0);
+}
+
+TEST(Conversions, PosesAndTransformsRoundTrip)
+{
+  const core::Pose2 pose(1.5, -2.25, 2.5);
+  const core::Pose2 a = fl::fromPoseMsg(fl::toPoseMsg(pose));
+  const core::Pose2 b = fl::fromTransformMsg(fl::toTransformMsg(pose));
+  const core::Pose2 c = fl::fromPose2D(fl::toPose2D(pose));
+  for (const core::Pose2& p : { a, b, c })
+  {
+    EXPECT_NEAR(p.x, pose.x, 1e-12);
+    EXPECT_NEAR(p.y, pose.y, 1e-12);
+    EXPECT_NEAR(p.theta, pose.theta, 1e-12);
+  }
+  geometry_msgs::Pose2D unwrapped;
+  unwrapped.theta = 3.0 * core::kPi / 2.0;
+  EXPECT_NEAR(fl::fromPose2D(unwrapped).theta, -core::kPi / 2.0, 1e-12);
+}
+
+TEST(Conversions, OccupancyGridMatchesTheMap)
+{
+  std::vector<core::Ring> rings = { { Vec2(0, 0), Vec2(2, 0), Vec2(2, 1), Vec2(0, 1) },
+                                    { Vec2(0.8, 0.3), Vec2(1.2, 0.3), Vec2(1.2, 0.7), Vec2(0.8, 0.7) } };
+  core::MapRayCaster caster(core::PolygonMap::fromRings(rings, "grid_room"));
+  const double res = 0.05;
+  const nav_msgs::OccupancyGrid grid = fl::toOccupancyGrid(caster, res, "map", ros::Time(1.0));
+  ASSERT_EQ(grid.data.size(), static_cast<std::size_t>(grid.info.width) * grid.info.height);
+  EXPECT_EQ(grid.header.frame_id, "map");
+  auto cell = [&](double x, double y) {
+    const int col = static_cast<int>(std::floor((x - grid.info.origin.position.x) / res));
+    const int row = static_cast<int>(std::floor((y - grid.info.origin.position.y) / res));
+    return grid.data[static_cast<std::size_t>(row) * grid.info.width + static_cast<std::size_t>(col)];
+  };
+  EXPECT_EQ(cell(0.4, 0.5), 0);     // free
+  EXPECT_EQ(cell(1.0, 0.5), 100);   // inside the hole
+  EXPECT_EQ(cell(0.8, 0.5), 100);   // on the hole's wall
+  EXPECT_EQ(cell(-0.08, 0.5), -1);  // outside the map
+  int free_cells = 0;
+  for (std::int8_t v : grid.data)
+  {
+    free_cells += v == 0 ? 1 : 0;
+  }
+  // Free area 2 - 0.16 = 1.84 m^2, less the cells the walls (7.6 m) touch on either side.
+  EXPECT_GT(free_cells * res * res, 1.84 - 2.0 * 7.6 * res);
+  EXPECT_LT(free_cells * res * res, 1.84);
+  EXPECT_THROW(fl::toOccupancyGrid(caster, 0.0, "map", ros::Time(1.0)), std::invalid_argument);
+}
+
+TEST(Conversions, MarkersCarryTheGeometry)
+{
+  std::vector<core::Ring> rings = { { Vec2(0, 0), Vec2(2, 0), Vec2(2, 1), Vec2(0, 1) } };
+  const core::PolygonMap map = core::PolygonMap::fromRings(rings, "box");
+  const auto walls = fl::mapMarkers(map, "map", ros::Time(1.0));
+  ASSERT_EQ(walls.markers.size(), 1u);
+  EXPECT_EQ(walls.markers[0].points.size(), 2 * map.edges().size());
+  const std::vector<core::Obstacle> obstacles = { core::Obstacle::disc(Vec2(0.5, 0.5), 0.1),
+                                                  core::Obstacle::polygon({ Vec2(1, 0.2), Vec2(1.3, 0.2), Vec2(1.1, 0.5) }) };
+  const auto markers = fl::obstacleMarkers(obstacles, "map", ros::Time(1.0), 4);
+  ASSERT_EQ(markers.markers.size(), 4u);
+  EXPECT_EQ(markers.markers[0].type, visualization_msgs::Marker::CYLINDER);
+  EXPECT_DOUBLE_EQ(markers.markers[0].scale.x, 0.2);
+  EXPECT_DOUBLE_EQ(markers.markers[0].pose.position.x, 0.5);
+  EXPECT_EQ(markers.markers[1].type, visualization_msgs::Marker::LINE_STRIP);
+  EXPECT_EQ(markers.markers[1].points.size(), 4u);  // closed
+  EXPECT_EQ(markers.markers[2].action, visualization_msgs::Marker::DELETE);
+  EXPECT_EQ(markers.markers[3].action, visualization_msgs::Marker::DELETE);
+}
+
+TEST(ParamUtils, XmlRpcTreesConvert)
+{
+  XmlRpc::XmlRpcValue root;
+  root["name"] = std::string("x");
+  root["count"] = 3;
+  root["rate"] = 2.5;
+  root["on"] = true;
+  root["points"][0][0] = 1.0;
+  root["points"][0][1] = 2;
+  const core::ParamValue v = fl::fromXmlRpc(root);
+  ASSERT_TRUE(v.isMap());
+  EXPECT_EQ(v.find("name")->asString(), "x");
+  EXPECT_EQ(v.find("count")->asInt(), 3);
+  EXPECT_DOUBLE_EQ(v.find("rate")->asDouble(), 2.5);
+  EXPECT_TRUE(v.find("on")->asBool());
+  ASSERT_TRUE(v.find("points")->isList());
+  EXPECT_DOUBLE_EQ(v.find("points")->items()[0].items()[1].asDouble(), 2.0);
+}
+
+TEST(ParamUtils, ResourcePathsResolve)
+{
+  std::string error;
+  EXPECT_EQ(fl::resolveResourcePath("/a/b.poly", &error), "/a/b.poly");
+  EXPECT_EQ(fl::resolveResourcePath("file:///a/b.poly", &error), "/a/b.poly");
+  EXPECT_EQ(fl::resolveResourcePath("package://", &error), "");
+  EXPECT_NE(error.find("package://PACKAGE/PATH"), std::string::npos);
+  error.clear();
+  EXPECT_EQ(fl::resolveResourcePath("package://no_such_package_fdml/x.poly", &error), "");
+  EXPECT_NE(error.find("no_such_package_fdml"), std::string::npos);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Localizer node conversions (issue 6).
+// ---------------------------------------------------------------------------------------------
 
 namespace fdml_localization
 {
@@ -20,14 +144,7 @@ void expectPoseNear(const core::Pose2& a, const core::Pose2& b, double tol = 1e-
   EXPECT_NEAR(core::angleDiff(a.theta, b.theta), 0.0, tol);
 }
 
-core::Pose2 randomPose(std::mt19937& rng)
-{
-  std::uniform_real_distribution<double> xy(-50.0, 50.0);
-  std::uniform_real_distribution<double> angle(-core::kPi, core::kPi);
-  return core::Pose2(xy(rng), xy(rng), angle(rng));
-}
-
-TEST(Conversions, YawQuaternionRoundTripAndAxis)
+TEST(LocalizerConversions, YawOfUnnormalisedAndBrokenQuaternions)
 {
   for (int i = -40; i <= 40; ++i)
   {
@@ -51,20 +168,7 @@ TEST(Conversions, YawQuaternionRoundTripAndAxis)
   EXPECT_EQ(quaternionToYaw(broken), 0.0);
 }
 
-TEST(Conversions, PoseMessagesRoundTrip)
-{
-  std::mt19937 rng(7);
-  for (int i = 0; i < 100; ++i)
-  {
-    const core::Pose2 pose = randomPose(rng);
-    expectPoseNear(fromPoseMsg(toPoseMsg(pose)), pose);
-    expectPoseNear(fromPose2D(toPose2D(pose)), pose);
-    expectPoseNear(fromTransformMsg(toTransformMsg(pose)), pose);
-    EXPECT_EQ(toPoseMsg(pose).position.z, 0.0);
-  }
-}
-
-TEST(Conversions, CovarianceEmbedsInXYYaw)
+TEST(LocalizerConversions, CovarianceEmbedsInXYYaw)
 {
   Eigen::Matrix3d covariance;
   covariance << 1.0, 0.2, 0.3, 0.2, 2.0, 0.4, 0.3, 0.4, 3.0;
@@ -88,7 +192,7 @@ TEST(Conversions, CovarianceEmbedsInXYYaw)
   EXPECT_TRUE(fromCovariance6(six).isApprox(covariance, 0.0));
 }
 
-TEST(Conversions, ReadingMessagesRoundTripIncludingNoReturn)
+TEST(LocalizerConversions, ReadingMessagesRoundTripIncludingNoReturn)
 {
   core::Reading reading;
   reading.offset = core::Pose2(0.1, -0.2, 1.5);
@@ -109,7 +213,7 @@ TEST(Conversions, ReadingMessagesRoundTripIncludingNoReturn)
   EXPECT_EQ(fromReadingMsgs(msgs).size(), 3u);
 }
 
-TEST(Conversions, ResultAndCandidateMessages)
+TEST(LocalizerConversions, ResultAndCandidateMessages)
 {
   core::Result result;
   core::Candidate candidate;
@@ -169,7 +273,7 @@ sensor_msgs::Range rangeMsg(double range)
   return msg;
 }
 
-TEST(Conversions, RangeFollowsRep117)
+TEST(LocalizerConversions, RangeFollowsRep117)
 {
   TimedReading reading;
   std::string reason;
@@ -203,7 +307,7 @@ TEST(Conversions, RangeFollowsRep117)
   EXPECT_TRUE(rangeToReading(rangeMsg(4.0), 13.0, &reading, &reason));
 }
 
-TEST(Conversions, ScanTakesEvenlySpacedUsableBeams)
+TEST(LocalizerConversions, ScanTakesEvenlySpacedUsableBeams)
 {
   sensor_msgs::LaserScan scan;
   scan.header.frame_id = "laser";
@@ -252,23 +356,7 @@ TEST(Conversions, ScanTakesEvenlySpacedUsableBeams)
   EXPECT_EQ(scanToReadings(scan, 1000, 101.0, &drops).size(), 269u);
 }
 
-TEST(Conversions, MapMarkerListsEveryEdge)
-{
-  const core::PolygonMap map = core::PolygonMap::fromRings(
-      { { core::Vec2(0, 0), core::Vec2(4, 0), core::Vec2(4, 3), core::Vec2(0, 3) },
-        { core::Vec2(1, 1), core::Vec2(1, 2), core::Vec2(2, 2), core::Vec2(2, 1) } });
-  const visualization_msgs::Marker marker = mapMarker(map, "map");
-  EXPECT_EQ(marker.type, visualization_msgs::Marker::LINE_LIST);
-  EXPECT_EQ(marker.header.frame_id, "map");
-  ASSERT_EQ(marker.points.size(), 2 * map.edges().size());
-  for (std::size_t i = 0; i < map.edges().size(); ++i)
-  {
-    EXPECT_EQ(marker.points[2 * i].x, map.edges()[i].a.x());
-    EXPECT_EQ(marker.points[2 * i + 1].y, map.edges()[i].b.y());
-  }
-}
-
-TEST(Conversions, ReadingMarkersDrawRaysFromThePoseColouredByInlier)
+TEST(LocalizerConversions, ReadingMarkersDrawRaysFromThePoseColouredByInlier)
 {
   const core::Pose2 pose(1.0, 2.0, 0.5);
   std::vector<core::Reading> readings(3);

@@ -20,8 +20,9 @@ public:
 };
 
 /**
- * @brief Resolves a map location to a file path: "package://PKG/rel/path" through the ROS package
- *        path (roslib), "file:///abs/path" to "/abs/path", anything else unchanged.
+ * @brief Resolves a map location to a file path with resolveResourcePath() (param_utils.h):
+ *        "package://PKG/rel/path" through the ROS package path, "file:///abs/path" to
+ *        "/abs/path", anything else unchanged.
  * @throws MapLoadError when the package is not found or the URI is malformed.
  */
 std::string resolveMapPath(const std::string& location);

@@ -169,6 +169,65 @@ TEST(Params, CoreOptionsAreCopied)
   EXPECT_EQ(toLocalizerOptions(params).engine, core::Engine::Voxel);
 }
 
+TEST(Params, AgreesWithTheCoreValidation)
+{
+  // What the node accepts, the core accepts ...
+  std::vector<std::function<void(Params&)>> accepted = {
+    [](Params&) {},
+    [](Params& p) {
+      p.resolution = 16;
+      p.theta_resolution = 1024;
+      p.min_inliers = 3;
+    },
+    [](Params& p) {
+      p.resolution = 1024;
+      p.theta_resolution = 16;
+      p.measurements_per_batch = 255;
+      p.min_inliers = 255;
+    },
+    [](Params& p) {
+      p.method = "paper";
+      p.min_inliers = 6;
+    },
+    [](Params& p) { p.method = "baseline"; },
+    [](Params& p) {
+      p.agreement_tolerance = 10.0;
+      p.uniqueness_distance = 0.0;
+      p.uniqueness_angle = 0.0;
+      p.range_tolerance = 0.0;
+      p.max_candidates = 1;
+      p.threads = 1;
+      p.max_boxes = 1000;
+      p.deadline = 3600.0;
+    },
+  };
+  for (std::size_t i = 0; i < accepted.size(); ++i)
+  {
+    Params params = validParams();
+    accepted[i](params);
+    EXPECT_TRUE(validate(params).empty()) << i;
+    const std::vector<std::string> core_errors = core::validate(toLocalizerOptions(params));
+    EXPECT_TRUE(core_errors.empty()) << i << ": " << (core_errors.empty() ? "" : core_errors[0]);
+  }
+  // ... and every core option the core rejects, the node rejects first (naming the parameter).
+  std::vector<std::function<void(Params&)>> rejected = {
+    [](Params& p) { p.resolution = 15; },         [](Params& p) { p.resolution = 1025; },
+    [](Params& p) { p.theta_resolution = 15; },   [](Params& p) { p.min_inliers = 2; },
+    [](Params& p) { p.agreement_tolerance = 0.0; }, [](Params& p) { p.uniqueness_distance = -1.0; },
+    [](Params& p) { p.uniqueness_angle = -1.0; }, [](Params& p) { p.range_tolerance = -0.01; },
+    [](Params& p) { p.max_candidates = 0; },      [](Params& p) { p.threads = -1; },
+    [](Params& p) { p.max_boxes = 999; },         [](Params& p) { p.deadline = -1.0; },
+    [](Params& p) { p.method = "paper"; },
+  };
+  for (std::size_t i = 0; i < rejected.size(); ++i)
+  {
+    Params params = validParams();
+    rejected[i](params);
+    EXPECT_FALSE(core::validate(toLocalizerOptions(params)).empty()) << i;
+    EXPECT_FALSE(validate(params).empty()) << i;
+  }
+}
+
 TEST(Params, ModeParsing)
 {
   SolveMode mode = SolveMode::OnRequest;

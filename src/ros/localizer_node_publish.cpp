@@ -115,8 +115,12 @@ LocalizerNode::Outcome LocalizerNode::solve(const Job& job)
   {
     publishBatchOutcome(job, result, outcome);
   }
-  ROS_INFO("fdml_localizer: %s: %s (%.3f s)", job.from_sensors ? "batch" : "~localize", outcome.message.c_str(),
-           result.times.total);
+  // Continuous mode solves many batches a second: its per-batch line is a debug message.
+  const ros::console::levels::Level level = job.from_sensors && mode_ == SolveMode::Continuous
+                                                ? ros::console::levels::Debug
+                                                : ros::console::levels::Info;
+  ROS_LOG(level, ROSCONSOLE_DEFAULT_NAME, "fdml_localizer: %s: %s (%.3f s)", job.from_sensors ? "batch" : "~localize",
+          outcome.message.c_str(), result.times.total);
   return outcome;
 }
 

@@ -2,12 +2,12 @@
 
 #include "fdml_localization/ros/conversions.h"
 
-#include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/PoseArray.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include <chrono>
+#include <cmath>
 
 namespace fdml_localization
 {

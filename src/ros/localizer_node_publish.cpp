@@ -10,6 +10,7 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 namespace fdml_localization

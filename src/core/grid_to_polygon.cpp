@@ -8,7 +8,6 @@
 #include <cstdint>
 #include <filesystem>
 #include <sstream>
-#include <unordered_map>
 
 namespace fdml_localization
 {
@@ -68,84 +67,80 @@ int labelRegions(const std::vector<char>& free, int width, int height, std::vect
 }
 
 /**
- * Marching squares over the region mask, padded by one non-region cell on every side. Nodes
- * are cell centres; contour points are midpoints between a region node and a non-region node.
- * Each square emits segments with the region on their left, pairing each exit crossing with
- * the entry crossing before it in counter-clockwise order, so at a saddle the two region
- * cells stay apart (the region is 4-connected, the walls 8-connected). Returns rings in local
- * cell units: cell (ix, iy) spans [ix, ix + 1] x [iy, iy + 1].
+ * Traces the boundary of the region along the cell edges, region on the left, so straight
+ * walls lie exactly on the cell edges. At a vertex where the region touches itself only
+ * diagonally (a saddle), the trace turns tightly around each cell, so the region stays
+ * 4-connected and the walls 8-connected, and cuts a tiny chamfer (kChamfer cells) off each
+ * of the two region corners there, so that no ring touches itself or another.
+ * Returns rings in local cell units: cell (ix, iy) spans [ix, ix + 1] x [iy, iy + 1].
  */
-std::vector<Ring> traceContours(const std::vector<char>& region, int width, int height)
+std::vector<Ring> traceBoundaries(const std::vector<char>& region, int width, int height)
 {
-  const int pw = width + 2;
-  const int ph = height + 2;
-  auto inside = [&](int i, int j) {
-    const int x = i - 1;
-    const int y = j - 1;
+  constexpr double kChamfer = 0.125;  // exact in binary: keeps cell-unit arithmetic exact
+  // Side s of a cell runs from its corner s to corner s + 1 (counter-clockwise: bottom, right,
+  // top, left); kDir[s] is its direction and kDir[s + 1] the inward normal (the region side).
+  static const int kDir[4][2] = { { 1, 0 }, { 0, 1 }, { -1, 0 }, { 0, -1 } };
+  static const int kCorner[4][2] = { { 0, 0 }, { 1, 0 }, { 1, 1 }, { 0, 1 } };
+  auto in = [&](int x, int y) {
     return x >= 0 && y >= 0 && x < width && y < height && region[static_cast<std::size_t>(y) * width + x];
   };
-  // Crossing keys: 2 * node + 0 for the edge to the node's right, + 1 for the edge above it.
-  auto hKey = [&](int i, int j) { return 2 * (static_cast<std::int64_t>(j) * pw + i); };
-  auto vKey = [&](int i, int j) { return 2 * (static_cast<std::int64_t>(j) * pw + i) + 1; };
-  std::unordered_map<std::int64_t, std::int64_t> next;
-  for (int j = 0; j + 1 < ph; ++j)
-  {
-    for (int i = 0; i + 1 < pw; ++i)
-    {
-      const bool c[4] = {inside(i, j), inside(i + 1, j), inside(i + 1, j + 1), inside(i, j + 1)};
-      if (c[0] == c[1] && c[1] == c[2] && c[2] == c[3])
-      {
-        continue;
-      }
-      const std::int64_t keys[4] = {hKey(i, j), vKey(i + 1, j), hKey(i, j + 1), vKey(i, j)};
-      for (int k = 0; k < 4; ++k)
-      {
-        if (!(c[k] && !c[(k + 1) % 4]))
-        {
-          continue;  // not an exit crossing
-        }
-        for (int back = 1; back < 4; ++back)
-        {
-          const int m = (k + 4 - back) % 4;
-          if (!c[m] && c[(m + 1) % 4])
-          {
-            next[keys[k]] = keys[m];
-            break;
-          }
-        }
-      }
-    }
-  }
-  auto pointOf = [&](std::int64_t key) {
-    const std::int64_t node = key / 2;
-    const double i = static_cast<double>(node % pw);
-    const double j = static_cast<double>(node / pw);
-    // Node (i, j) is the centre of cell (i - 1, j - 1), at (i - 0.5, j - 0.5) in cell units.
-    return (key % 2 == 0) ? Vec2(i, j - 0.5) : Vec2(i - 0.5, j);
+  auto isBoundary = [&](int x, int y, int s) {
+    const int* n = kDir[(s + 1) % 4];
+    return in(x, y) && !in(x - n[0], y - n[1]);
   };
+  std::vector<std::uint8_t> visited(region.size(), 0);  // one bit per side
   std::vector<Ring> rings;
-  std::unordered_map<std::int64_t, bool> used;
-  used.reserve(next.size());
-  for (const auto& entry : next)
+  for (int y0 = 0; y0 < height; ++y0)
   {
-    if (used.count(entry.first))
+    for (int x0 = 0; x0 < width; ++x0)
     {
-      continue;
-    }
-    Ring ring;
-    std::int64_t key = entry.first;
-    while (!used.count(key))
-    {
-      used[key] = true;
-      ring.push_back(pointOf(key));
-      const auto it = next.find(key);
-      if (it == next.end())
+      for (int s0 = 0; s0 < 4; ++s0)
       {
-        break;
+        const std::size_t c0 = static_cast<std::size_t>(y0) * width + x0;
+        if (!isBoundary(x0, y0, s0) || (visited[c0] & (1u << s0)))
+        {
+          continue;
+        }
+        Ring ring;
+        int x = x0;
+        int y = y0;
+        int s = s0;
+        do
+        {
+          visited[static_cast<std::size_t>(y) * width + x] |= static_cast<std::uint8_t>(1u << s);
+          const int* d = kDir[s];
+          const int* n = kDir[(s + 1) % 4];
+          const Vec2 v(x + kCorner[(s + 1) % 4][0], y + kCorner[(s + 1) % 4][1]);
+          if (!in(x + d[0], y + d[1]))
+          {
+            // Left turn around the same cell; a saddle when the diagonal cell is region too.
+            if (in(x + d[0] - n[0], y + d[1] - n[1]))
+            {
+              ring.push_back(v - kChamfer * Vec2(d[0], d[1]));
+              ring.push_back(v + kChamfer * Vec2(n[0], n[1]));
+            }
+            else
+            {
+              ring.push_back(v);
+            }
+            s = (s + 1) % 4;
+          }
+          else if (!in(x + d[0] - n[0], y + d[1] - n[1]))
+          {
+            x += d[0];  // straight on along the next cell's same side
+            y += d[1];
+          }
+          else
+          {
+            ring.push_back(v);  // right turn onto the diagonal cell
+            x += d[0] - n[0];
+            y += d[1] - n[1];
+            s = (s + 3) % 4;
+          }
+        } while (!(x == x0 && y == y0 && s == s0));
+        rings.push_back(std::move(ring));
       }
-      key = it->second;
     }
-    rings.push_back(std::move(ring));
   }
   return rings;
 }
@@ -241,7 +236,7 @@ PolygonMap gridToPolygon(const OccupancyGrid& grid, const GridConversionOptions&
   {
     region[i] = labels[i] == chosen;
   }
-  std::vector<Ring> contours = traceContours(region, w, h);
+  std::vector<Ring> contours = traceBoundaries(region, w, h);
   // The outer boundary is the one counter-clockwise ring; every clockwise ring is a hole.
   std::vector<Ring> rings(1);
   double outer_area = 0.0;
@@ -274,24 +269,21 @@ PolygonMap gridToPolygon(const OccupancyGrid& grid, const GridConversionOptions&
     }
     rings.push_back(std::move(ring));
   }
-  // Into metres in the grid's frame (simplify there: yaw does not change distances).
-  for (Ring& ring : rings)
+  // Simplify in cell units, where every traced vertex is a multiple of 1/8 cell, so the
+  // touching and crossing tests are exact; then scale and apply the origin pose.
+  for (const Ring& ring : rings)
   {
     info.vertices_traced += static_cast<long>(ring.size());
-    for (Vec2& p : ring)
-    {
-      p *= res;
-    }
   }
   SimplifyStats stats;
-  std::vector<Ring> simple = simplifyRings(rings, info.tolerance_used, &stats);
+  std::vector<Ring> simple = simplifyRings(rings, info.tolerance_used / res, &stats);
   info.rings_tightened = stats.rings_tightened;
   for (Ring& ring : simple)
   {
     info.vertices_kept += static_cast<long>(ring.size());
     for (Vec2& p : ring)
     {
-      p = grid.toMap(p);
+      p = grid.toMap(p * res);
     }
   }
   if (report != nullptr)

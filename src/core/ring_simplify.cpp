@@ -52,32 +52,29 @@ Ring dropCollinear(const Ring& ring)
   return out.size() >= 3 ? out : ring;
 }
 
-/// Orientation sign of (a, b, c): +1 left turn, -1 right turn, 0 collinear.
-int orient(const Vec2& a, const Vec2& b, const Vec2& c)
+/// Orientation sign of (a, b, c): +1 left turn, -1 right turn, 0 when c lies within @p eps [m]
+/// of the line through a and b.
+int orient(const Vec2& a, const Vec2& b, const Vec2& c, double eps)
 {
-  const double v = cross(b - a, c - a);
-  return (v > 0.0) - (v < 0.0);
+  const Vec2 ab = b - a;
+  const double v = cross(ab, c - a);
+  const double band = eps * ab.norm();
+  return v > band ? 1 : (v < -band ? -1 : 0);
 }
 
-bool onSegment(const Vec2& a, const Vec2& b, const Vec2& p)
+/// True when the closed segments pq and rs come within @p eps [m] of each other.
+bool closedSegmentsMeet(const Vec2& p, const Vec2& q, const Vec2& r, const Vec2& s, double eps)
 {
-  return std::min(a.x(), b.x()) <= p.x() && p.x() <= std::max(a.x(), b.x()) && std::min(a.y(), b.y()) <= p.y() &&
-         p.y() <= std::max(a.y(), b.y());
-}
-
-/// True when the closed segments pq and rs share a point.
-bool closedSegmentsMeet(const Vec2& p, const Vec2& q, const Vec2& r, const Vec2& s)
-{
-  const int o1 = orient(p, q, r);
-  const int o2 = orient(p, q, s);
-  const int o3 = orient(r, s, p);
-  const int o4 = orient(r, s, q);
-  if (o1 != o2 && o3 != o4)
+  const int o1 = orient(p, q, r, 0.0);
+  const int o2 = orient(p, q, s, 0.0);
+  const int o3 = orient(r, s, p, 0.0);
+  const int o4 = orient(r, s, q, 0.0);
+  if (o1 * o2 < 0 && o3 * o4 < 0)
   {
-    return true;
+    return true;  // a proper crossing
   }
-  return (o1 == 0 && onSegment(p, q, r)) || (o2 == 0 && onSegment(p, q, s)) || (o3 == 0 && onSegment(r, s, p)) ||
-         (o4 == 0 && onSegment(r, s, q));
+  return distanceToSegment(r, p, q) <= eps || distanceToSegment(s, p, q) <= eps || distanceToSegment(p, r, s) <= eps ||
+         distanceToSegment(q, r, s) <= eps;
 }
 
 bool insideRing(const Vec2& p, const Ring& ring)
@@ -227,6 +224,9 @@ std::vector<bool> findInvalidRings(const std::vector<Ring>& rings)
   // Bucket grid over every edge's bounding box.
   const Vec2 size = all.size();
   const double extent = std::max({size.x(), size.y(), 1e-9});
+  // Closer than this counts as touching: well above rounding, far below any map feature.
+  const double eps = 1e-9 * std::max({extent, std::abs(all.min.x()), std::abs(all.min.y()), std::abs(all.max.x()),
+                                      std::abs(all.max.y())});
   const int cells_per_side = std::clamp(static_cast<int>(std::sqrt(static_cast<double>(edges.size()))), 1, 1024);
   const double cell = extent / cells_per_side * (1.0 + 1e-9);
   const int nx = std::max(1, static_cast<int>(size.x() / cell) + 1);
@@ -238,10 +238,10 @@ std::vector<bool> findInvalidRings(const std::vector<Ring>& rings)
     const Ring& ring = rings[edges[e].ring];
     const Vec2& p = ring[edges[e].index];
     const Vec2& q = ring[(edges[e].index + 1) % ring.size()];
-    const int x0 = clampCell((std::min(p.x(), q.x()) - all.min.x()) / cell, nx);
-    const int x1 = clampCell((std::max(p.x(), q.x()) - all.min.x()) / cell, nx);
-    const int y0 = clampCell((std::min(p.y(), q.y()) - all.min.y()) / cell, ny);
-    const int y1 = clampCell((std::max(p.y(), q.y()) - all.min.y()) / cell, ny);
+    const int x0 = clampCell((std::min(p.x(), q.x()) - eps - all.min.x()) / cell, nx);
+    const int x1 = clampCell((std::max(p.x(), q.x()) + eps - all.min.x()) / cell, nx);
+    const int y0 = clampCell((std::min(p.y(), q.y()) - eps - all.min.y()) / cell, ny);
+    const int y1 = clampCell((std::max(p.y(), q.y()) + eps - all.min.y()) / cell, ny);
     for (int cy = y0; cy <= y1; ++cy)
     {
       for (int cx = x0; cx <= x1; ++cx)
@@ -277,11 +277,11 @@ std::vector<bool> findInvalidRings(const std::vector<Ring>& rings)
           const Vec2& shared = e_first ? q : p;
           const Vec2& u = e_first ? p : q;
           const Vec2& w = e_first ? s : r;
-          meet = orient(u, shared, w) == 0 && (u - shared).dot(w - shared) > 0.0;
+          meet = orient(u, shared, w, eps) == 0 && (u - shared).dot(w - shared) > 0.0;
         }
         else
         {
-          meet = closedSegmentsMeet(p, q, r, s);
+          meet = closedSegmentsMeet(p, q, r, s, eps);
         }
         if (meet)
         {
@@ -295,10 +295,12 @@ std::vector<bool> findInvalidRings(const std::vector<Ring>& rings)
   // cross at this point for good rings, so one vertex decides).
   if (!rings.empty() && !bad[0])
   {
+    const Ring& outer = rings[0];
     for (int r = 1; r < ring_count; ++r)
     {
-      if (!bad[r] && !insideRing(rings[r].front(), rings[0]))
+      if (!bad[r] && !insideRing(rings[r].front(), outer))
       {
+        bad[0] = true;  // either ring may have moved: tighten both
         bad[r] = true;
       }
     }

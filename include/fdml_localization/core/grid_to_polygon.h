@@ -49,10 +49,11 @@ struct GridConversionReport
  * @brief Converts an occupancy grid into a valid polygon with holes.
  *
  * Picks the 4-connected free region holding the seed (or the largest), traces its boundary
- * with marching squares through the midpoints between cell centres (so straight walls lie on
- * the cell edges; diagonal wall cells stay closed), drops holes under min_area, simplifies
- * every ring with Douglas-Peucker and, where that would make rings cross or touch, simplifies
- * that ring again with a smaller tolerance. The origin's yaw is applied.
+ * along the cell edges (so before simplification a ray meets the polygon where it meets the
+ * first non-free cell; where two wall cells touch only at a corner the wall stays closed,
+ * with a 1/8-cell chamfer off the free cells' corners there), drops holes under min_area,
+ * simplifies every ring with Douglas-Peucker and, where that would make rings cross or touch,
+ * simplifies those rings again with a smaller tolerance. The origin's yaw is applied.
  *
  * @param source names the grid in errors (a file path or a topic)
  * @param report when not null, receives what was done

@@ -80,9 +80,9 @@ double raySegmentDistance(const Vec2& origin, const Vec2& dir, const Segment& se
     {
       return kInf;
     }
-    if ((ta <= 0.0) != (tb <= 0.0))
+    if (ta <= 0.0 || tb <= 0.0)
     {
-      return 0.0;  // the origin lies on the segment
+      return 0.0;  // the origin lies on the segment (possibly at an endpoint)
     }
     return std::min(ta, tb);
   }

@@ -1,0 +1,106 @@
+// Rays per second of the grid ray cast against the brute-force loop over every edge, on the
+// office and warehouse maps (and a large generated building), on 1 and 2 threads.
+// Each iteration casts a fixed batch of rays from random free points in an OpenMP loop;
+// items_per_second is rays per second (wall-clock).
+#include "fdml_localization/core/map_generators.h"
+#include "fdml_localization/core/map_io.h"
+#include "fdml_localization/core/ray_caster.h"
+
+#include <benchmark/benchmark.h>
+#include <omp.h>
+
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace
+{
+namespace core = fdml_localization::core;
+
+constexpr int kBatch = 8192;
+
+struct RayBatch
+{
+  std::vector<core::Vec2> origins;
+  std::vector<core::Vec2> dirs;
+};
+
+RayBatch makeBatch(const core::MapRayCaster& caster, std::uint64_t seed)
+{
+  RayBatch batch;
+  std::mt19937_64 rng(seed);
+  const core::Box2& b = caster.map().bounds();
+  std::uniform_real_distribution<double> ux(b.min.x(), b.max.x()), uy(b.min.y(), b.max.y());
+  std::uniform_real_distribution<double> angle(-core::kPi, core::kPi);
+  while (static_cast<int>(batch.origins.size()) < kBatch)
+  {
+    const core::Vec2 p(ux(rng), uy(rng));
+    if (caster.isFree(p))
+    {
+      const double a = angle(rng);
+      batch.origins.push_back(p);
+      batch.dirs.emplace_back(std::cos(a), std::sin(a));
+    }
+  }
+  return batch;
+}
+
+void castBatch(benchmark::State& state, std::shared_ptr<const core::MapRayCaster> caster, bool accelerated,
+               int threads)
+{
+  const RayBatch batch = makeBatch(*caster, 1234);
+  const core::SegmentGrid& grid = caster->grid();
+  for (auto _ : state)
+  {
+    double sum = 0.0;
+#pragma omp parallel for num_threads(threads) reduction(+ : sum) schedule(static)
+    for (int i = 0; i < kBatch; ++i)
+    {
+      const core::RayHit hit = accelerated ? grid.cast(batch.origins[i], batch.dirs[i])
+                                           : grid.castBruteForce(batch.origins[i], batch.dirs[i]);
+      sum += hit.distance;
+    }
+    benchmark::DoNotOptimize(sum);
+  }
+  state.SetItemsProcessed(state.iterations() * kBatch);
+  state.counters["edges"] = static_cast<double>(grid.segments().size());
+}
+
+void registerAll()
+{
+  std::vector<std::pair<std::string, std::shared_ptr<const core::MapRayCaster>>> maps;
+  for (const char* name : { "office", "warehouse" })
+  {
+    const std::string path = std::string(FDML_SOURCE_DIR) + "/maps/" + name + ".poly";
+    maps.emplace_back(name, std::make_shared<const core::MapRayCaster>(core::loadPolyFile(path)));
+  }
+  core::BuildingOptions options;  // 60 m x 40 m
+  maps.emplace_back("building60x40", std::make_shared<const core::MapRayCaster>(core::generateBuilding(options)));
+  for (const auto& [name, caster] : maps)
+  {
+    for (const bool accelerated : { false, true })
+    {
+      for (const int threads : { 1, 2 })
+      {
+        const std::string label =
+            "RayCast/" + name + (accelerated ? "/grid" : "/brute") + "/threads:" + std::to_string(threads);
+        benchmark::RegisterBenchmark(label.c_str(), castBatch, caster, accelerated, threads)->UseRealTime();
+      }
+    }
+  }
+}
+}  // namespace
+
+int main(int argc, char** argv)
+{
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv))
+  {
+    return 1;
+  }
+  registerAll();
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -68,7 +68,8 @@ void writePreviewPng(const std::string& path, const OccupancyGrid& grid, const P
   {
     throw std::invalid_argument("writePreviewPng(" + path + "): invalid grid: " + issues.front());
   }
-  const int scale = std::clamp(800 / std::max(grid.width, grid.height), 1, 8);
+  const int longest = std::max(grid.width, grid.height);
+  const int scale = std::clamp((1200 + longest - 1) / longest, 1, 8);
   Canvas canvas;
   canvas.width = grid.width * scale;
   canvas.height = grid.height * scale;

@@ -94,7 +94,7 @@ OccupancyGrid rasterize(const PolygonMap& map, const RasterizeOptions& options);
 /**
  * @brief Writes a PNG preview: the grid in grey (free white, occupied black, unknown grey),
  *        the polygon's outer ring in blue and its holes in red drawn over it. Small grids are
- *        scaled up (an integer factor) so the result is at least about 800 pixels wide.
+ *        scaled up (an integer factor, at most 8) to about 1200 pixels along the longer side.
  * @throws std::runtime_error naming the file when it cannot be written.
  */
 void writePreviewPng(const std::string& path, const OccupancyGrid& grid, const PolygonMap& map);

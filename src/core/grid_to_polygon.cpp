@@ -28,7 +28,7 @@ int labelRegions(const std::vector<char>& free, int width, int height, std::vect
 {
   labels->assign(free.size(), -1);
   sizes->clear();
-  std::vector<int> queue;
+  std::vector<int> stack;
   for (std::size_t start = 0; start < free.size(); ++start)
   {
     if (!free[start] || (*labels)[start] >= 0)
@@ -37,12 +37,12 @@ int labelRegions(const std::vector<char>& free, int width, int height, std::vect
     }
     const int label = static_cast<int>(sizes->size());
     long count = 0;
-    queue.assign(1, static_cast<int>(start));
+    stack.assign(1, static_cast<int>(start));
     (*labels)[start] = label;
-    while (!queue.empty())
+    while (!stack.empty())
     {
-      const int idx = queue.back();
-      queue.pop_back();
+      const int idx = stack.back();
+      stack.pop_back();
       ++count;
       const int x = idx % width;
       const int y = idx / width;
@@ -57,7 +57,7 @@ int labelRegions(const std::vector<char>& free, int width, int height, std::vect
         if (free[nidx] && (*labels)[nidx] < 0)
         {
           (*labels)[nidx] = label;
-          queue.push_back(nidx);
+          stack.push_back(nidx);
         }
       }
     }

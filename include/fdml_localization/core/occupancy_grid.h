@@ -57,7 +57,7 @@ struct OccupancyGrid
 enum class MapMode
 {
   Trinary,  ///< free 0, occupied 100, anything between: unknown -1 (the default)
-  Scale,    ///< free 0, occupied 100, between: 99 * (p - free) / (occ - free); alpha < 255: unknown
+  Scale,    ///< free 0, occupied 100, between: 99 (p - free) / (occ - free), unknown where alpha is 0
   Raw       ///< the grey value itself (after negate) is the cell value
 };
 
@@ -89,7 +89,7 @@ MapYaml loadMapYamlFile(const std::string& path);
  * @brief Converts decoded pixels to cells with map_server's semantics: the mean of the
  *        colour channels (alpha excluded unless trinary), negated when asked, gives
  *        p = (255 - value) / 255; p > occupied_thresh -> 100, p < free_thresh -> 0, else
- *        -1 (trinary, or alpha < 255 in scale) or 99 (p - free) / (occ - free) (scale);
+ *        -1 (trinary, or alpha 0 in scale) or 99 (p - free) / (occ - free) (scale);
  *        raw copies the value (as a signed byte, so 255 becomes -1). The first image row is
  *        the top of the map (the grid's last row).
  * @param pixels width * height * channels bytes, rows from the top of the image

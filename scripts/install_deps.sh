@@ -18,6 +18,9 @@ PACKAGES=(
   libgtest-dev googletest libbenchmark-dev
   # demo, visualisation and plots
   rviz xvfb imagemagick python3-matplotlib python3-yaml
+  # python message modules for the demo client and rostopic
+  python3-rospy python3-std-msgs python3-geometry-msgs python3-nav-msgs python3-sensor-msgs
+  python3-std-srvs python3-visualization-msgs
 )
 
 missing=()

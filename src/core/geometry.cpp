@@ -66,8 +66,8 @@ double raySegmentDistance(const Vec2& origin, const Vec2& dir, const Segment& se
   const Vec2 e = seg.b - seg.a;
   const Vec2 w = seg.a - origin;
   const double denom = cross(dir, e);
-  const double scale = std::max(e.norm(), 1e-300);
-  if (std::abs(denom) <= 1e-14 * scale)
+  // Parallel when |dir x e| <= 1e-14 |e| (compared squared: no square root on the hot path).
+  if (denom * denom <= 1e-28 * e.squaredNorm())
   {
     // Parallel: a hit only when collinear, then at the nearest point ahead of the origin.
     if (std::abs(cross(w, dir)) > 1e-12 * std::max(1.0, w.norm()))

@@ -65,6 +65,10 @@ double Obstacle::castDistance(const Vec2& origin, const Vec2& dir) const
   {
     return rayCircleDistance(origin, dir, centre, radius);
   }
+  if (pointInRing(origin, vertices))
+  {
+    return 0.0;  // a sensor inside an obstacle sees it at once, as with a disc
+  }
   // The same segment primitive as the static map's grid cast.
   double best = kInf;
   const std::size_t n = vertices.size();

@@ -34,7 +34,7 @@ struct Obstacle
   bool contains(const Vec2& p) const;
   /// Axis-aligned bounds [m].
   Box2 bounds() const;
-  /// Nearest hit of a ray on the obstacle's boundary [m] (+inf on a miss).
+  /// Nearest hit of a ray on the obstacle's boundary [m] (+inf on a miss; 0 when the origin is inside).
   double castDistance(const Vec2& origin, const Vec2& dir) const;
 };
 

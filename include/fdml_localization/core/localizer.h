@@ -84,6 +84,14 @@ public:
   using std::invalid_argument::invalid_argument;
 };
 
+/**
+ * @brief Checks a batch against the options: at least 3 and at most 255 readings, finite
+ *        offsets, ranges >= 0 and not NaN, a finite max_range > 0 for every no-return reading,
+ *        no finite range beyond its max_range, and k' <= k.
+ * @throws InvalidInput naming the first problem (and the reading's index)
+ */
+void validateReadings(const std::vector<Reading>& readings, const LocalizerOptions& options);
+
 /// One candidate pose.
 struct Candidate
 {
@@ -148,6 +156,8 @@ public:
 
   const LocalizerOptions& options() const { return options_; }
   const MapRayCaster& map() const { return *map_; }
+  /// The engine behind this localizer (for diagnostics and tests).
+  LocalizerEngine& engine() { return *engine_; }
 
 private:
   std::shared_ptr<const MapRayCaster> map_;

@@ -4,6 +4,7 @@
 #include "fdml_localization/core/ring_simplify.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>

@@ -26,6 +26,11 @@ double secondsSince(std::chrono::steady_clock::time_point start)
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+/// Where rays hit near a concave corner, h is the minimum of two linear pieces and peaks between
+/// samples, above all of them, by up to about the slope difference times half a cell: the band
+/// [d - tau, d + tau] is widened by this many cells so the truth's voxel stays in its preimage.
+constexpr double kKinkMargin = 0.5;
+
 int floorDiv(double value)
 {
   return static_cast<int>(std::floor(value));
@@ -120,9 +125,9 @@ void VoxelEngine::fillPreimageSlice(const Reading& reading, int it, VoxelSet& se
   const int ny = spec_.ny;
   const int nt = spec_.nt;
   const bool no_return = !std::isfinite(reading.range);
-  const float lo = static_cast<float>(no_return ? reading.max_range - options_.range_tolerance
-                                                : reading.range - options_.range_tolerance);
-  const float hi = static_cast<float>(reading.range + options_.range_tolerance);
+  const double band = preimageBand();
+  const float lo = static_cast<float>(no_return ? reading.max_range - band : reading.range - band);
+  const float hi = static_cast<float>(reading.range + band);
   const std::size_t slice = static_cast<std::size_t>(nx) * ny;
   const double theta = spec_.centreTheta(it);
   const double c = std::cos(theta);
@@ -150,6 +155,11 @@ void VoxelEngine::fillPreimageSlice(const Reading& reading, int it, VoxelSet& se
     const std::size_t base = static_cast<std::size_t>(t0) * slice + static_cast<std::size_t>(iy + sy) * nx + sx;
     markRow(bmin + base, bmax + base, x_begin, x_end, lo, hi, no_return, set.row(iy, it));
   }
+}
+
+double VoxelEngine::preimageBand() const
+{
+  return options_.range_tolerance + kKinkMargin * spec_.cell;
 }
 
 VoxelSet VoxelEngine::rawPreimage(const Reading& reading)

@@ -39,9 +39,17 @@ public:
   const std::string& cacheMessage() const { return cache_message_; }
 
   /**
+   * @brief Half-width b of the band [d - b, d + b] the preimages test [m]: the range tolerance
+   *        tau plus half a cell, because where a ray hits near a concave corner h peaks between
+   *        samples, above all of them, by up to about half a cell times the slope difference.
+   */
+  double preimageBand() const;
+
+  /**
    * @brief The voxel preimage of one reading before dilation: voxel v is in it when the
-   *        samples of h around (centre of v) (+) g take values on both sides of [d - tau, d + tau]
-   *        or inside it (for d = +inf: some sample exceeds max_range - tau). Prepares on first use.
+   *        samples of h around (centre of v) (+) g take values on both sides of [d - b, d + b]
+   *        or inside it (for d = +inf: some sample exceeds max_range - b), b = preimageBand().
+   *        Prepares on first use.
    */
   VoxelSet rawPreimage(const Reading& reading);
   /// The dilated preimages of a batch, one per reading.

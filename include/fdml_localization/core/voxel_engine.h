@@ -20,6 +20,18 @@ namespace fdml_localization
 {
 namespace core
 {
+/**
+ * @brief The voxel engine. Per call: (1) the preimage of each reading by the sign-change test
+ *        on the distance table's 2 x 2 x 2 sample blocks, then a one-voxel dilation (bit-packed
+ *        sets); (2) the count field (uint8 per voxel), M_k' = {count >= k'}; (3) seeds.
+ *        Robust method: the regional maxima (peak plateaus) of the count field of the dilated
+ *        preimages and of the raw ones, level by level from k down, each refined by
+ *        refineSeed() (exact ray casts, robust polish); in automatic mode the first level where
+ *        a seed explains that many readings is k'; supports are the sizes of the seeds'
+ *        components of M_k'. Paper and baseline methods: the circular-mean centres of the
+ *        components of M_k' (26-neighbour, periodic theta), the eps filter, delta uniqueness.
+ *        Ranking and duplicate removal: rankAndDeduplicate().
+ */
 class VoxelEngine : public LocalizerEngine
 {
 public:

@@ -37,7 +37,8 @@ ResidualRow residualRow(const MapRayCaster& map, const Pose2& q, const Rotation&
   ResidualRow row;
   const double c = rq.c;
   const double s = rq.s;
-  const Vec2 origin(q.x + c * reading.offset.x - s * reading.offset.y, q.y + s * reading.offset.x + c * reading.offset.y);
+  const Vec2 origin(q.x + c * reading.offset.x - s * reading.offset.y,
+                    q.y + s * reading.offset.x + c * reading.offset.y);
   if (!map.isFree(origin))
   {
     return row;

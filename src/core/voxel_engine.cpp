@@ -56,7 +56,8 @@ void markRow(const float* rmin, const float* rmax, int begin, int end, float lo,
   const __m128 vhi = _mm_set1_ps(no_return ? std::numeric_limits<float>::infinity() : hi);
   for (; ix + 4 <= end; ix += 4)
   {
-    const __m128 in = _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(rmin + ix), vhi), _mm_cmpge_ps(_mm_loadu_ps(rmax + ix), vlo));
+    const __m128 below = _mm_cmple_ps(_mm_loadu_ps(rmin + ix), vhi);
+    const __m128 in = _mm_and_ps(below, _mm_cmpge_ps(_mm_loadu_ps(rmax + ix), vlo));
     row[ix >> 6] |= static_cast<std::uint64_t>(_mm_movemask_ps(in)) << (ix & 63);
   }
 #endif

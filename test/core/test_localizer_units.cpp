@@ -478,11 +478,14 @@ TEST(LocalizerInput, BadInputIsAClearError)
   LocalizerOptions paper = options;
   paper.method = Method::Paper;
   EXPECT_THROW(Localizer(map, paper), std::invalid_argument);
+  // The resolution's range depends on the engine: the adaptive engine goes far finer.
   LocalizerOptions adaptive = options;
   adaptive.engine = Engine::Adaptive;
   EXPECT_NO_THROW(Localizer(map, adaptive));
-  adaptive.resolution = 2000;  // fine for the adaptive engine, too many voxels for the voxel one
+  adaptive.resolution = 5000;  // fine for the adaptive engine, too many voxels for the voxel one
   EXPECT_TRUE(validate(adaptive).empty());
+  adaptive.resolution = 200000;
+  EXPECT_EQ(validate(adaptive).size(), 1u);
   EXPECT_THROW(Localizer(std::make_shared<const MapRayCaster>(), options), std::invalid_argument);
   EXPECT_TRUE(validate(LocalizerOptions()).empty());
 }

@@ -1,5 +1,7 @@
 #include "fdml_localization/core/localizer.h"
 
+#include "fdml_localization/core/adaptive_engine.h"
+
 #include "fdml_localization/core/voxel_engine.h"
 
 #include <cmath>
@@ -83,14 +85,17 @@ Engine parseEngine(const std::string& text)
 std::vector<std::string> validate(const LocalizerOptions& o)
 {
   std::vector<std::string> errors;
-  if (o.resolution < 16 || o.resolution > 1024)
+  // The voxel engine holds n x n x n_theta samples; the adaptive engine only the boxes it keeps.
+  const int max_resolution = o.engine == Engine::Voxel ? kMaxVoxelResolution : kMaxAdaptiveResolution;
+  const std::string range = "[16, " + std::to_string(max_resolution) + "] for engine " + toString(o.engine);
+  if (o.resolution < 16 || o.resolution > max_resolution)
   {
-    errors.push_back("resolution " + std::to_string(o.resolution) + " is outside [16, 1024]");
+    errors.push_back("resolution " + std::to_string(o.resolution) + " is outside " + range);
   }
-  if (o.theta_resolution != 0 && (o.theta_resolution < 16 || o.theta_resolution > 1024))
+  if (o.theta_resolution != 0 && (o.theta_resolution < 16 || o.theta_resolution > max_resolution))
   {
-    errors.push_back("theta_resolution " + std::to_string(o.theta_resolution) +
-                     " is outside [16, 1024] (0 = resolution)");
+    errors.push_back("theta_resolution " + std::to_string(o.theta_resolution) + " is outside " + range +
+                     " (0 = resolution)");
   }
   if (o.min_inliers != 0 && (o.min_inliers < 3 || o.min_inliers > 255))
   {
@@ -206,7 +211,8 @@ Localizer::Localizer(std::shared_ptr<const MapRayCaster> map, const LocalizerOpt
       engine_ = std::make_unique<VoxelEngine>(map_, options_);
       break;
     case Engine::Adaptive:
-      throw std::invalid_argument("engine adaptive is not available yet (use voxel)");
+      engine_ = std::make_unique<AdaptiveEngine>(map_, options_);
+      break;
   }
 }
 

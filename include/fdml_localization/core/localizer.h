@@ -54,12 +54,18 @@ Method parseMethod(const std::string& text);
 /// Parses "voxel" / "adaptive"; throws std::invalid_argument otherwise.
 Engine parseEngine(const std::string& text);
 
+/// Largest resolution of the voxel engine (its table holds n x n x n_theta samples).
+constexpr int kMaxVoxelResolution = 1024;
+/// Largest resolution of the adaptive engine (1 mm cells over a 100 m map).
+constexpr int kMaxAdaptiveResolution = 100000;
+
 /// Localizer options. validate() lists every out-of-range value.
 struct LocalizerOptions
 {
   Engine engine = Engine::Voxel;
   Method method = Method::Robust;
-  int resolution = 100;            ///< cells along the map's longer side, in [16, 1024]
+  int resolution = 100;            ///< cells along the map's longer side, in [16, 1024] (voxel)
+                                   ///< or [16, 100000] (adaptive)
   int theta_resolution = 0;        ///< cells in theta; 0 = resolution
   int min_inliers = 0;             ///< k' in [3, k]; 0 = automatic (maximum consensus)
   double agreement_tolerance = 0.05;  ///< eps [m]: a reading agrees when |h - d| < eps

@@ -1,6 +1,7 @@
 // fdml_bench: the paper's benchmark protocol (method.md section 5) on any maps. Prints the
 // paper-style table on stdout, progress on stderr, one CSV row per trial with --csv.
 #include "fdml_localization/core/benchmark_runner.h"
+#include "fdml_localization/core/text_parsing.h"
 #include "fdml_localization/core/map_generators.h"
 #include "fdml_localization/core/map_io.h"
 
@@ -38,34 +39,7 @@ struct UsageError : std::runtime_error
   using std::runtime_error::runtime_error;
 };
 
-double parseNumber(const std::string& text, const std::string& flag)
-{
-  std::size_t used = 0;
-  double value = 0.0;
-  try
-  {
-    value = std::stod(text, &used);
-  }
-  catch (const std::exception&)
-  {
-    used = 0;
-  }
-  if (used != text.size() || text.empty() || !std::isfinite(value))
-  {
-    throw UsageError(flag + ": '" + text + "' is not a number");
-  }
-  return value;
-}
 
-int parseInt(const std::string& text, const std::string& flag)
-{
-  const double v = parseNumber(text, flag);
-  if (v != std::floor(v) || std::abs(v) > 1e9)
-  {
-    throw UsageError(flag + ": '" + text + "' is not an integer");
-  }
-  return static_cast<int>(v);
-}
 
 std::vector<std::string> splitList(const std::string& text)
 {
@@ -84,7 +58,7 @@ std::vector<int> parseIntList(const std::string& text, const std::string& flag)
   std::vector<int> out;
   for (const std::string& item : splitList(text))
   {
-    out.push_back(parseInt(item, flag));
+    out.push_back(core::parseInteger(item, flag));
   }
   if (out.empty())
   {
@@ -101,7 +75,7 @@ std::pair<std::string, double> splitScale(const std::string& text, const std::st
   {
     return { text, 1.0 };
   }
-  const double scale = parseNumber(text.substr(colon + 1), flag + " scale");
+  const double scale = core::parseNumber(text.substr(colon + 1), flag + " scale");
   if (!(scale > 0.0))
   {
     throw UsageError(flag + ": scale " + text.substr(colon + 1) + " must be > 0");
@@ -141,7 +115,7 @@ core::BenchScene mapScene(const std::string& spec)
 core::BenchScene randomScene(const std::string& spec, std::uint64_t seed)
 {
   const auto [count, scale] = splitScale(spec, "--random");
-  const int vertices = parseInt(count, "--random");
+  const int vertices = core::parseInteger(count, "--random");
   if (vertices < 3 || vertices > 100000)
   {
     throw UsageError("--random: VERTICES = " + count + " must be in [3, 100000]");
@@ -194,16 +168,16 @@ Cli parseArgs(int argc, char** argv)
     }
     else if (flag == "--radius")
     {
-      c.protocol.obstacle_radius = parseNumber(value(), flag);
+      c.protocol.obstacle_radius = core::parseNumber(value(), flag);
     }
     else if (flag == "--k")
     {
-      c.protocol.readings = parseInt(value(), flag);
+      c.protocol.readings = core::parseInteger(value(), flag);
     }
     else if (flag == "--min-inliers")
     {
       const std::string v = value();
-      c.min_inliers = v == "auto" ? 0 : parseInt(v, flag);
+      c.min_inliers = v == "auto" ? 0 : core::parseInteger(v, flag);
     }
     else if (flag == "--resolution")
     {
@@ -211,11 +185,11 @@ Cli parseArgs(int argc, char** argv)
     }
     else if (flag == "--trials")
     {
-      c.trials = parseInt(value(), flag);
+      c.trials = core::parseInteger(value(), flag);
     }
     else if (flag == "--seed")
     {
-      const int seed = parseInt(value(), flag);
+      const int seed = core::parseInteger(value(), flag);
       if (seed < 0)
       {
         throw UsageError("--seed must be >= 0");
@@ -250,7 +224,7 @@ Cli parseArgs(int argc, char** argv)
     }
     else if (flag == "--threads")
     {
-      c.threads = parseInt(value(), flag);
+      c.threads = core::parseInteger(value(), flag);
     }
     else if (flag == "--moving-obstacles")
     {
@@ -262,7 +236,7 @@ Cli parseArgs(int argc, char** argv)
     }
     else if (flag == "--noise")
     {
-      c.protocol.noise = parseNumber(value(), flag);
+      c.protocol.noise = core::parseNumber(value(), flag);
     }
     else if (flag == "--csv")
     {

@@ -8,6 +8,7 @@
  * Exit status: 0 on success, 2 on bad arguments or bad input (the message names the problem).
  */
 #include "fdml_localization/core/grid_to_polygon.h"
+#include "fdml_localization/core/text_parsing.h"
 #include "fdml_localization/core/map_io.h"
 
 #include <cmath>
@@ -30,25 +31,6 @@ const char* kUsage =
     "  --occupied-threshold N   cells with value >= N (1..100) are walls (default 50); unknown is a wall\n"
     "  --no-preview             do not write OUT.png\n";
 
-/// Parses a whole string as a finite double; throws std::invalid_argument naming the option.
-double parseNumber(const std::string& text, const std::string& option)
-{
-  std::size_t used = 0;
-  double value = 0.0;
-  try
-  {
-    value = std::stod(text, &used);
-  }
-  catch (const std::exception&)
-  {
-    used = 0;
-  }
-  if (used == 0 || used != text.size() || !std::isfinite(value))
-  {
-    throw std::invalid_argument(option + ": '" + text + "' is not a finite number");
-  }
-  return value;
-}
 
 struct Arguments
 {
@@ -74,7 +56,7 @@ Arguments parseArguments(int argc, char** argv)
     };
     if (arg == "--tolerance")
     {
-      args.options.tolerance = parseNumber(value(), arg);
+      args.options.tolerance = core::parseNumber(value(), arg);
       if (args.options.tolerance <= 0.0)
       {
         throw std::invalid_argument("--tolerance must be > 0 [m]");
@@ -82,7 +64,7 @@ Arguments parseArguments(int argc, char** argv)
     }
     else if (arg == "--min-area")
     {
-      args.options.min_area = parseNumber(value(), arg);
+      args.options.min_area = core::parseNumber(value(), arg);
       if (args.options.min_area < 0.0)
       {
         throw std::invalid_argument("--min-area must be >= 0 [m^2]");
@@ -97,11 +79,12 @@ Arguments parseArguments(int argc, char** argv)
         throw std::invalid_argument("--seed-point: expected X,Y, got '" + text + "'");
       }
       args.options.use_seed = true;
-      args.options.seed_point = core::Vec2(parseNumber(text.substr(0, comma), arg), parseNumber(text.substr(comma + 1), arg));
+      args.options.seed_point =
+          core::Vec2(core::parseNumber(text.substr(0, comma), arg), core::parseNumber(text.substr(comma + 1), arg));
     }
     else if (arg == "--occupied-threshold")
     {
-      const double n = parseNumber(value(), arg);
+      const double n = core::parseNumber(value(), arg);
       if (n != std::floor(n) || n < 1 || n > 100)
       {
         throw std::invalid_argument("--occupied-threshold must be an integer in [1, 100]");

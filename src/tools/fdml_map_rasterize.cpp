@@ -8,6 +8,7 @@
  * Exit status: 0 on success, 2 on bad arguments or bad input.
  */
 #include "fdml_localization/core/grid_to_polygon.h"
+#include "fdml_localization/core/text_parsing.h"
 #include "fdml_localization/core/map_io.h"
 
 #include <cmath>
@@ -30,28 +31,10 @@ const char* kUsage =
     "  --islands N     small free blobs in the unknown area (default 0)\n"
     "  --seed S        random seed (default 1)\n";
 
-double parseNumber(const std::string& text, const std::string& option)
-{
-  std::size_t used = 0;
-  double value = 0.0;
-  try
-  {
-    value = std::stod(text, &used);
-  }
-  catch (const std::exception&)
-  {
-    used = 0;
-  }
-  if (used == 0 || used != text.size() || !std::isfinite(value))
-  {
-    throw std::invalid_argument(option + ": '" + text + "' is not a finite number");
-  }
-  return value;
-}
 
 int parseCount(const std::string& text, const std::string& option)
 {
-  const double v = parseNumber(text, option);
+  const double v = core::parseNumber(text, option);
   if (v != std::floor(v) || v < 0 || v > 1e9)
   {
     throw std::invalid_argument(option + " must be a non-negative integer");
@@ -80,19 +63,19 @@ int main(int argc, char** argv)
       };
       if (arg == "--resolution")
       {
-        options.resolution = parseNumber(value(), arg);
+        options.resolution = core::parseNumber(value(), arg);
       }
       else if (arg == "--margin")
       {
-        options.margin = parseNumber(value(), arg);
+        options.margin = core::parseNumber(value(), arg);
       }
       else if (arg == "--wall")
       {
-        options.wall_thickness = parseNumber(value(), arg);
+        options.wall_thickness = core::parseNumber(value(), arg);
       }
       else if (arg == "--noise")
       {
-        options.boundary_noise = parseNumber(value(), arg);
+        options.boundary_noise = core::parseNumber(value(), arg);
       }
       else if (arg == "--specks")
       {

@@ -38,16 +38,7 @@ LocalizerNode::LocalizerNode(const ros::NodeHandle& nh, const ros::NodeHandle& p
   , diagnostics_(nh, private_nh)
   , buffer_(bufferOptions(params))
 {
-  if (map_)
-  {
-    if (!map.summary.empty())
-    {
-      ROS_INFO("fdml_localizer: map converted from %s", map.summary.c_str());
-    }
-    localizer_.reset(new core::Localizer(map_, optionsFor(map)));
-    have_map_ = true;
-    map_source_ = map.source;
-  }
+  setUpMaps(map);
   service_nh_.setCallbackQueue(&service_queue_);
   global_service_nh_.setCallbackQueue(&service_queue_);
 
@@ -63,12 +54,6 @@ LocalizerNode::LocalizerNode(const ros::NodeHandle& nh, const ros::NodeHandle& p
 
   range_sub_ = nh_.subscribe(params_.range_topic, 100, &LocalizerNode::rangeCallback, this);
   scan_sub_ = nh_.subscribe(params_.scan_topic, 10, &LocalizerNode::scanCallback, this);
-  if (params_.use_map_topic)
-  {
-    map_sub_ = nh_.subscribe("map", 1, &LocalizerNode::mapCallback, this);
-    ROS_INFO("fdml_localizer: taking maps from %s%s", map_sub_.getTopic().c_str(),
-             map_ ? "" : " (no map until one arrives)");
-  }
 
   process_timer_ = nh_.createWallTimer(ros::WallDuration(0.02), &LocalizerNode::processTimer, this);
   if (params_.publish_tf)

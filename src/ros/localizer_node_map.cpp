@@ -8,6 +8,27 @@
 
 namespace fdml_localization
 {
+void LocalizerNode::setUpMaps(const LoadedMap& map)
+{
+  if (map.map)
+  {
+    if (!map.summary.empty())
+    {
+      ROS_INFO("fdml_localizer: map converted from %s", map.summary.c_str());
+    }
+    localizer_.reset(new core::Localizer(map.map, optionsFor(map)));
+    have_map_ = true;
+    map_source_ = map.source;
+  }
+  if (params_.use_map_topic)
+  {
+    // The callback only stores the message: nothing else runs before the worker starts.
+    map_sub_ = nh_.subscribe("map", 1, &LocalizerNode::mapCallback, this);
+    ROS_INFO("fdml_localizer: taking maps from %s%s", map_sub_.getTopic().c_str(),
+             map.map ? "" : " (no map until one arrives)");
+  }
+}
+
 void LocalizerNode::mapCallback(const nav_msgs::OccupancyGrid::ConstPtr& msg)
 {
   // Only store it: the worker converts it and builds the tables (seconds for a large map).

@@ -131,6 +131,8 @@ private:
   Outcome solve(const Job& job);
 
   // Maps (localizer_node_map.cpp).
+  /// Constructor step: the localizer of the ~map_file map (if any), the map topic subscription.
+  void setUpMaps(const LoadedMap& map);
   void mapCallback(const nav_msgs::OccupancyGrid::ConstPtr& msg);
   /// The core options for @p map: the parameters, with withGridTolerances() for a converted grid
   /// (the effective tolerances are logged).

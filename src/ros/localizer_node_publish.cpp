@@ -71,6 +71,16 @@ LocalizerNode::Outcome LocalizerNode::solve(const Job& job)
   outcome.result = toResultMsg(result);
   outcome.result.header.frame_id = params_.global_frame_id;
   outcome.result.header.stamp = job.from_sensors ? stampToTime(job.batch.newest_stamp) : ros::Time::now();
+  if (job.from_sensors)
+  {
+    // Like ~candidates, the result's poses are the robot's at its stamp (the newest reading),
+    // not at the batch's first reading where the core expresses them.
+    for (std::size_t i = 0; i < result.candidates.size(); ++i)
+    {
+      outcome.result.candidates[i].pose =
+          toPoseMsg(carryForward(result.candidates[i].pose, job.batch.base_first, job.batch.base_newest));
+    }
+  }
   const bool unambiguous = solved && isUnambiguous(result);
   if (solved)
   {

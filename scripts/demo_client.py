@@ -67,6 +67,8 @@ def main():
     parser.add_argument("--pos-tol", type=float, default=0.05, help="[m]")
     parser.add_argument("--ang-tol", type=float, default=2.0, help="[deg]")
     parser.add_argument("--timeout", type=float, default=60.0, help="per relocalization [s]")
+    parser.add_argument("--stop-when-unambiguous", action="store_true",
+                        help="stop after the first correct answer with a single best candidate")
     args = parser.parse_args(rospy.myargv()[1:])
 
     rospy.init_node("fdml_demo_client")
@@ -105,6 +107,11 @@ def main():
         print("%-3d (%7.3f, %7.3f, %+6.3f)   (%7.3f, %7.3f, %+6.3f)   %9.2f %8.2f %5d %8.3f %s" % (
             n, truth_pose[0], truth_pose[1], truth_pose[2], bx, by, byaw, 100.0 * err_pos, err_ang,
             len(result.candidates), result.solve_time, "ok" if ok else "MISS"))
+        cands = result.candidates
+        unambiguous = len(cands) == 1 or cands[0].inliers > cands[1].inliers
+        if args.stop_when_unambiguous and ok and unambiguous:
+            args.kidnaps = n
+            break
     median_cm = sorted(e[0] for e in errors)[len(errors) // 2] * 100.0 if errors else float("nan")
     print("summary: %d of %d kidnaps relocalized within %.0f cm and %.0f deg; median error %.2f cm" % (
         good, args.kidnaps, args.pos_tol * 100.0, args.ang_tol, median_cm))

@@ -77,32 +77,6 @@ bool closedSegmentsMeet(const Vec2& p, const Vec2& q, const Vec2& r, const Vec2&
          distanceToSegment(q, r, s) <= eps;
 }
 
-bool insideRing(const Vec2& p, const Ring& ring)
-{
-  bool inside = false;
-  const std::size_t n = ring.size();
-  for (std::size_t i = 0, j = n - 1; i < n; j = i++)
-  {
-    const Vec2& a = ring[i];
-    const Vec2& b = ring[j];
-    if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < a.x() + (p.y() - a.y()) * (b.x() - a.x()) / (b.y() - a.y()))
-    {
-      inside = !inside;
-    }
-  }
-  return inside;
-}
-
-double ringArea(const Ring& ring)
-{
-  double sum = 0.0;
-  const std::size_t n = ring.size();
-  for (std::size_t i = 0, j = n - 1; i < n; j = i++)
-  {
-    sum += cross(ring[j], ring[i]);
-  }
-  return 0.5 * sum;
-}
 
 Box2 ringBounds(const Ring& ring)
 {
@@ -204,7 +178,7 @@ std::vector<bool> findInvalidRings(const std::vector<Ring>& rings)
   for (int r = 0; r < ring_count; ++r)
   {
     const Ring& ring = rings[r];
-    const double area = ring.size() >= 3 ? ringArea(ring) : 0.0;
+    const double area = ring.size() >= 3 ? signedArea(ring) : 0.0;
     if (ring.size() < 3 || area == 0.0 || !std::isfinite(area))
     {
       bad[r] = true;
@@ -298,7 +272,7 @@ std::vector<bool> findInvalidRings(const std::vector<Ring>& rings)
     const Ring& outer = rings[0];
     for (int r = 1; r < ring_count; ++r)
     {
-      if (!bad[r] && !insideRing(rings[r].front(), outer))
+      if (!bad[r] && !pointInRing(rings[r].front(), outer))
       {
         bad[0] = true;  // either ring may have moved: tighten both
         bad[r] = true;
@@ -313,7 +287,7 @@ std::vector<bool> findInvalidRings(const std::vector<Ring>& rings)
       {
         continue;
       }
-      if (insideRing(rings[r].front(), rings[t]) || insideRing(rings[t].front(), rings[r]))
+      if (pointInRing(rings[r].front(), rings[t]) || pointInRing(rings[t].front(), rings[r]))
       {
         bad[r] = true;
         bad[t] = true;

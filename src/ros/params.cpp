@@ -18,7 +18,7 @@ std::string quoted(const std::string& text)
 
 /// Appends "~name = value is out of range; allowed: range" when @p ok is false.
 template <typename T>
-void check(std::vector<std::string>* errors, bool ok, const char* name, const T& value, const char* allowed)
+void check(std::vector<std::string>* errors, bool ok, const char* name, const T& value, const std::string& allowed)
 {
   if (ok)
   {
@@ -117,9 +117,13 @@ std::vector<std::string> validate(const Params& p)
         "\"voxel\" or \"adaptive\"");
   check(&errors, p.method == "robust" || p.method == "paper" || p.method == "baseline", "method", quoted(p.method),
         "\"robust\", \"paper\" or \"baseline\"");
-  check(&errors, p.resolution >= 16 && p.resolution <= 1024, "resolution", p.resolution, "an integer in [16, 1024]");
-  check(&errors, p.theta_resolution == 0 || (p.theta_resolution >= 16 && p.theta_resolution <= 1024),
-        "theta_resolution", p.theta_resolution, "0 (= ~resolution) or an integer in [16, 1024]");
+  // The voxel engine's table holds n x n x n_theta samples; the adaptive engine goes far finer.
+  const int max_resolution = p.engine == "adaptive" ? core::kMaxAdaptiveResolution : core::kMaxVoxelResolution;
+  const std::string range = "[16, " + std::to_string(max_resolution) + "] for ~engine " + p.engine;
+  check(&errors, p.resolution >= 16 && p.resolution <= max_resolution, "resolution", p.resolution,
+        "an integer in " + range);
+  check(&errors, p.theta_resolution == 0 || (p.theta_resolution >= 16 && p.theta_resolution <= max_resolution),
+        "theta_resolution", p.theta_resolution, "0 (= ~resolution) or an integer in " + range);
   check(&errors, p.min_inliers == 0 || (p.min_inliers >= 3 && p.min_inliers <= k), "min_inliers", p.min_inliers,
         "0 (automatic) or an integer in [3, ~measurements_per_batch]");
   check(&errors, p.method != "paper" || p.min_inliers != 0, "min_inliers", p.min_inliers,

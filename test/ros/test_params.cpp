@@ -191,6 +191,11 @@ TEST(Params, AgreesWithTheCoreValidation)
     },
     [](Params& p) { p.method = "baseline"; },
     [](Params& p) {
+      p.engine = "adaptive";
+      p.resolution = 100000;
+      p.theta_resolution = 7200;
+    },
+    [](Params& p) {
       p.agreement_tolerance = 10.0;
       p.uniqueness_distance = 0.0;
       p.uniqueness_angle = 0.0;
@@ -212,6 +217,10 @@ TEST(Params, AgreesWithTheCoreValidation)
   // ... and every core option the core rejects, the node rejects first (naming the parameter).
   std::vector<std::function<void(Params&)>> rejected = {
     [](Params& p) { p.resolution = 15; },         [](Params& p) { p.resolution = 1025; },
+    [](Params& p) {
+      p.engine = "adaptive";
+      p.resolution = 100001;
+    },
     [](Params& p) { p.theta_resolution = 15; },   [](Params& p) { p.min_inliers = 2; },
     [](Params& p) { p.agreement_tolerance = 0.0; }, [](Params& p) { p.uniqueness_distance = -1.0; },
     [](Params& p) { p.uniqueness_angle = -1.0; }, [](Params& p) { p.range_tolerance = -0.01; },

@@ -4,12 +4,16 @@
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
+#include <tf2/LinearMath/Transform.h>
 #include <tf2/utils.h>
+#include <tf2_geometry_msgs/tf2_geometry_msgs.h>
+#include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/transform_listener.h>
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <deque>
 #include <mutex>
 
@@ -67,6 +71,50 @@ private:
   ros::Subscriber sub_;
 };
 
+/// The map -> odom transforms on /tf, numbered in arrival order.
+class MapToOdomRecorder
+{
+public:
+  explicit MapToOdomRecorder(ros::NodeHandle& nh) : sub_(nh.subscribe("/tf", 100, &MapToOdomRecorder::onTf, this)) {}
+
+  std::uint64_t count()
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return count_;
+  }
+
+  /// The newest map -> odom, when one arrived after the first @p after of them.
+  bool latestAfter(std::uint64_t after, geometry_msgs::TransformStamped& out)
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (count_ <= after)
+    {
+      return false;
+    }
+    out = latest_;
+    return true;
+  }
+
+private:
+  void onTf(const tf2_msgs::TFMessage& msg)
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const geometry_msgs::TransformStamped& t : msg.transforms)
+    {
+      if (t.header.frame_id == "map" && t.child_frame_id == "odom")
+      {
+        latest_ = t;
+        ++count_;
+      }
+    }
+  }
+
+  std::mutex mutex_;
+  std::uint64_t count_ = 0;
+  geometry_msgs::TransformStamped latest_;
+  ros::Subscriber sub_;
+};
+
 double angleError(double a, double b)
 {
   return std::abs(std::remainder(a - b, 2.0 * M_PI));
@@ -93,6 +141,7 @@ TEST(EndToEnd, KidnapsAreRelocalizedAndTfFollows)
 {
   ros::NodeHandle nh;
   TruthHistory truth(nh);
+  MapToOdomRecorder map_odom(nh);
   tf2_ros::Buffer tf_buffer(ros::Duration(30.0));
   tf2_ros::TransformListener tf_listener(tf_buffer);
   ros::ServiceClient kidnap = nh.serviceClient<fdml_localization::Kidnap>("fdml_simulator/kidnap");
@@ -114,6 +163,7 @@ TEST(EndToEnd, KidnapsAreRelocalizedAndTfFollows)
     fdml_localization::Relocalize srv;
     srv.request.timeout = 60.0;
     ASSERT_TRUE(relocalize.call(srv));
+    const std::uint64_t answered = map_odom.count();
     const auto& result = srv.response.result;
     if (!srv.response.success || result.candidates.empty())
     {
@@ -133,14 +183,23 @@ TEST(EndToEnd, KidnapsAreRelocalizedAndTfFollows)
     const bool unambiguous = result.candidates.size() == 1 || result.candidates[0].inliers > result.candidates[1].inliers;
     if (ok && unambiguous)
     {
-      // map -> odom (localizer) and odom -> base_link (simulator) compose to the true pose.
+      // The map -> odom the localizer publishes after this answer (future-dated, as AMCL does, so a
+      // tf lookup between the old and the new one would interpolate between them) composed with
+      // the simulator's odom -> base_link at the result's stamp is the true pose at that stamp.
+      geometry_msgs::TransformStamped map_to_odom;
+      ASSERT_TRUE(waitFor([&] { return map_odom.latestAfter(answered, map_to_odom); }, 10.0))
+          << "no map -> odom on tf after the answer";
       std::string error;
-      ASSERT_TRUE(tf_buffer.canTransform("map", "base_link", result.header.stamp, ros::Duration(10.0), &error))
+      ASSERT_TRUE(tf_buffer.canTransform("odom", "base_link", result.header.stamp, ros::Duration(5.0), &error))
           << error;
-      const geometry_msgs::TransformStamped tf =
-          tf_buffer.lookupTransform("map", "base_link", result.header.stamp);
-      EXPECT_LE(std::hypot(tf.transform.translation.x - t.x, tf.transform.translation.y - t.y), pos_tol);
-      EXPECT_LE(angleError(tf2::getYaw(tf.transform.rotation), t.yaw), ang_tol);
+      const geometry_msgs::TransformStamped odom_to_base =
+          tf_buffer.lookupTransform("odom", "base_link", result.header.stamp);
+      tf2::Transform a, b;
+      tf2::fromMsg(map_to_odom.transform, a);
+      tf2::fromMsg(odom_to_base.transform, b);
+      const tf2::Transform map_to_base = a * b;
+      EXPECT_LE(std::hypot(map_to_base.getOrigin().x() - t.x, map_to_base.getOrigin().y() - t.y), pos_tol);
+      EXPECT_LE(angleError(tf2::getYaw(map_to_base.getRotation()), t.yaw), ang_tol);
       ++tf_checked;
     }
   }

@@ -20,7 +20,12 @@ int main(int argc, char** argv)
   ROS_INFO_STREAM(fdml_localization::describe(params));
   try
   {
-    fdml_localization::LocalizerNode node(nh, private_nh, params, fdml_localization::loadMap(params.map_file));
+    fdml_localization::LoadedMap map;
+    if (!params.map_file.empty())
+    {
+      map = fdml_localization::loadMapFromFile(params.map_file, fdml_localization::toGridOptions(params));
+    }
+    fdml_localization::LocalizerNode node(nh, private_nh, params, map);
     ros::spin();
   }
   catch (const std::exception& error)

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <stdexcept>
 
 namespace fdml_localization
@@ -207,6 +208,32 @@ nav_msgs::OccupancyGrid toOccupancyGrid(const core::MapRayCaster& caster, double
   return grid;
 }
 
+core::OccupancyGrid fromOccupancyGridMsg(const nav_msgs::OccupancyGrid& msg)
+{
+  core::OccupancyGrid grid;
+  grid.width = static_cast<int>(std::min<std::uint32_t>(msg.info.width, std::numeric_limits<int>::max()));
+  grid.height = static_cast<int>(std::min<std::uint32_t>(msg.info.height, std::numeric_limits<int>::max()));
+  grid.resolution = msg.info.resolution;
+  grid.origin = core::Pose2(msg.info.origin.position.x, msg.info.origin.position.y,
+                            quaternionToYaw(msg.info.origin.orientation));
+  grid.cells.assign(msg.data.begin(), msg.data.end());
+  return grid;
+}
+
+nav_msgs::OccupancyGrid toOccupancyGridMsg(const core::OccupancyGrid& grid, const std::string& frame,
+                                           const ros::Time& stamp)
+{
+  nav_msgs::OccupancyGrid msg;
+  msg.header.frame_id = frame;
+  msg.header.stamp = stamp;
+  msg.info.map_load_time = stamp;
+  msg.info.resolution = static_cast<float>(grid.resolution);
+  msg.info.width = static_cast<std::uint32_t>(std::max(grid.width, 0));
+  msg.info.height = static_cast<std::uint32_t>(std::max(grid.height, 0));
+  msg.info.origin = toPoseMsg(grid.origin);
+  msg.data.assign(grid.cells.begin(), grid.cells.end());
+  return msg;
+}
 
 // ---------------------------------------------------------------------------------------------
 // Localizer node conversions (issue 6): covariance, readings, results, sensor input, rays.

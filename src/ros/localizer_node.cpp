@@ -25,11 +25,10 @@ ReadingBuffer::Options bufferOptions(const Params& params)
 }  // namespace
 
 LocalizerNode::LocalizerNode(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh, const Params& params,
-                             std::shared_ptr<const core::MapRayCaster> map)
+                             const LoadedMap& map)
   : params_(params)
   , mode_(solveMode(params))
-  , map_(std::move(map))
-  , localizer_(new core::Localizer(map_, toLocalizerOptions(params)))
+  , map_(map.map)
   , nh_(nh)
   , private_nh_(private_nh)
   , service_nh_(private_nh)
@@ -39,6 +38,7 @@ LocalizerNode::LocalizerNode(const ros::NodeHandle& nh, const ros::NodeHandle& p
   , diagnostics_(nh, private_nh)
   , buffer_(bufferOptions(params))
 {
+  setUpMaps(map);
   service_nh_.setCallbackQueue(&service_queue_);
   global_service_nh_.setCallbackQueue(&service_queue_);
 
@@ -274,10 +274,10 @@ bool LocalizerNode::relocalizeService(fdml_localization::Relocalize::Request& re
   std::future<Outcome> future = waiter->get_future();
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (shutting_down_)
+    if (shutting_down_ || !have_map_)
     {
       res.success = false;
-      res.message = "the node is shutting down";
+      res.message = shutting_down_ ? "the node is shutting down" : noMapMessage();
       return true;
     }
     startRelocalizationLocked(waiter);
@@ -315,10 +315,10 @@ bool LocalizerNode::localizeService(fdml_localization::Localize::Request& req,
   std::future<Outcome> future = waiter->get_future();
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (shutting_down_)
+    if (shutting_down_ || !have_map_)
     {
       res.success = false;
-      res.message = "the node is shutting down";
+      res.message = shutting_down_ ? "the node is shutting down" : noMapMessage();
       return true;
     }
     Job job;
@@ -337,6 +337,11 @@ bool LocalizerNode::localizeService(fdml_localization::Localize::Request& req,
 bool LocalizerNode::globalLocalizationService(std_srvs::Empty::Request& /*req*/, std_srvs::Empty::Response& /*res*/)
 {
   std::lock_guard<std::mutex> lock(mutex_);
+  if (!have_map_)
+  {
+    ROS_WARN("fdml_localizer: global_localization ignored: %s", noMapMessage().c_str());
+    return true;
+  }
   startRelocalizationLocked(nullptr);
   ROS_INFO("fdml_localizer: global localization started: waiting for %d fresh readings (rotate the robot in place "
            "or sweep the sensors)",
@@ -350,32 +355,44 @@ bool LocalizerNode::globalLocalizationService(std_srvs::Empty::Request& /*req*/,
 
 void LocalizerNode::workerLoop()
 {
-  try
+  if (localizer_)
   {
-    const auto start = std::chrono::steady_clock::now();
-    localizer_->prepare();
-    ROS_INFO("fdml_localizer: localizer ready (%s engine, tables in %.2f s)", params_.engine.c_str(),
-             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-  }
-  catch (const std::exception& error)
-  {
-    ROS_ERROR("fdml_localizer: preparing the localizer failed: %s", error.what());
+    try
+    {
+      const auto start = std::chrono::steady_clock::now();
+      localizer_->prepare();
+      ROS_INFO("fdml_localizer: localizer ready (%s engine, tables in %.2f s)", params_.engine.c_str(),
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    }
+    catch (const std::exception& error)
+    {
+      ROS_ERROR("fdml_localizer: preparing the localizer failed: %s", error.what());
+    }
   }
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    state_ = "idle";
+    state_ = localizer_ ? "idle" : "waiting for a map";
   }
   while (true)
   {
     Job job;
+    nav_msgs::OccupancyGrid::ConstPtr map;
     {
       std::unique_lock<std::mutex> lock(mutex_);
-      work_ready_.wait(lock, [this] { return shutting_down_ || queued_batch_ || !queued_requests_.empty(); });
+      work_ready_.wait(lock, [this] {
+        return shutting_down_ || pending_map_ || queued_batch_ || !queued_requests_.empty();
+      });
       if (shutting_down_)
       {
         return;
       }
-      if (!queued_requests_.empty())
+      if (pending_map_)
+      {
+        // A new map goes first: every solve after it uses it.
+        map.swap(pending_map_);
+        state_ = "converting a map from " + map_sub_.getTopic();
+      }
+      else if (!queued_requests_.empty())
       {
         job = std::move(queued_requests_.front());
         queued_requests_.pop_front();
@@ -387,7 +404,20 @@ void LocalizerNode::workerLoop()
         state_ = "solving a batch";
       }
     }
-    const Outcome outcome = solve(job);
+    if (map)
+    {
+      applyMap(map);
+      continue;
+    }
+    Outcome outcome;
+    if (localizer_)
+    {
+      outcome = solve(job);
+    }
+    else
+    {
+      outcome.message = noMapMessage();
+    }
     for (const OutcomePromise& waiter : job.waiters)
     {
       waiter->set_value(outcome);

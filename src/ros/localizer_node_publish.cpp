@@ -205,13 +205,22 @@ void LocalizerNode::publishMapToOdom(const ros::WallTimerEvent& /*event*/)
 
 void LocalizerNode::publishMapMarkers()
 {
+  if (!map_)
+  {
+    return;
+  }
   map_markers_pub_.publish(mapMarkers(map_->map(), params_.global_frame_id, ros::Time::now()));
 }
 
 void LocalizerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
 {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (last_candidates_ < 0)
+  if (!have_map_)
+  {
+    status.summary(maps_rejected_ > 0 ? diagnostic_msgs::DiagnosticStatus::ERROR : diagnostic_msgs::DiagnosticStatus::WARN,
+                   maps_rejected_ > 0 ? "no usable map: " + last_map_error_ : std::string("no map yet"));
+  }
+  else if (last_candidates_ < 0)
   {
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "no batch solved yet (" + state_ + ")");
   }
@@ -246,6 +255,15 @@ void LocalizerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   status.add("solver errors", solve_errors_);
   status.add("last solve time [s]", last_solve_time_);
   status.add("candidates", last_candidates_);
+  status.add("map", have_map_ ? map_source_ : std::string("(none yet)"));
+  if (params_.use_map_topic)
+  {
+    status.add("maps received", maps_received_);
+    status.add("maps in use", maps_accepted_);
+    status.add("maps rejected", maps_rejected_);
+    status.add("maps replaced before conversion", maps_replaced_);
+    status.add("last map error", last_map_error_);
+  }
 }
 
 }  // namespace fdml_localization

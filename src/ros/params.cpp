@@ -63,10 +63,31 @@ const char* toString(SolveMode mode)
 std::vector<std::string> validate(const Params& p)
 {
   std::vector<std::string> errors;
-  if (p.map_file.empty())
+  if (p.map_file.empty() && !p.use_map_topic)
   {
-    errors.push_back("~map_file is required: a .poly path, absolute or package://fdml_localization/maps/...");
+    errors.push_back("~map_file is required unless ~use_map_topic is true: a .poly or map_server .yaml path, "
+                     "absolute or package://fdml_localization/maps/...");
   }
+  check(&errors, finiteIn(p.map_simplify_tolerance, 0.0, 10.0), "map_simplify_tolerance", p.map_simplify_tolerance,
+        "0 (one cell) or (0, 10] m");
+  check(&errors, !std::isnan(p.map_min_area) && p.map_min_area <= 1e6, "map_min_area", p.map_min_area,
+        "< 0 (ten cells' area) or [0, 1e6] m^2");
+  const bool seed_ok = !p.map_seed_point_malformed &&
+                       (p.map_seed_point.empty() || (p.map_seed_point.size() == 2 && std::isfinite(p.map_seed_point[0]) &&
+                                                     std::isfinite(p.map_seed_point[1])));
+  if (!seed_ok)
+  {
+    std::ostringstream out;
+    out << "~map_seed_point = [";
+    for (std::size_t i = 0; i < p.map_seed_point.size(); ++i)
+    {
+      out << (i ? ", " : "") << p.map_seed_point[i];
+    }
+    out << "] is out of range; allowed: a list [x, y] of two finite numbers [m] (or unset: the largest free region)";
+    errors.push_back(out.str());
+  }
+  check(&errors, p.map_occupied_threshold >= 1 && p.map_occupied_threshold <= 100, "map_occupied_threshold",
+        p.map_occupied_threshold, "an integer in [1, 100]");
   const int k = p.measurements_per_batch;
   check(&errors, k >= 3 && k <= 255, "measurements_per_batch", k, "an integer in [3, 255]");
   check(&errors, p.batch_stride >= 1 && p.batch_stride <= std::max(k, 1), "batch_stride", p.batch_stride,
@@ -154,6 +175,38 @@ core::LocalizerOptions toLocalizerOptions(const Params& p)
   return options;
 }
 
+core::GridConversionOptions toGridOptions(const Params& p)
+{
+  core::GridConversionOptions options;
+  options.tolerance = p.map_simplify_tolerance;
+  options.min_area = p.map_min_area;
+  options.use_seed = p.map_seed_point.size() == 2;
+  if (options.use_seed)
+  {
+    options.seed_point = core::Vec2(p.map_seed_point[0], p.map_seed_point[1]);
+  }
+  options.occupied_threshold = p.map_occupied_threshold;
+  return options;
+}
+
+Params withGridTolerances(const Params& params, double resolution)
+{
+  Params p = params;
+  if (!(resolution > 0.0) || !std::isfinite(resolution))
+  {
+    return p;
+  }
+  if (!p.range_tolerance_set)
+  {
+    p.range_tolerance = std::max(p.range_tolerance, resolution);
+  }
+  if (!p.agreement_tolerance_set)
+  {
+    p.agreement_tolerance = std::max(p.agreement_tolerance, 2.0 * resolution);
+  }
+  return p;
+}
+
 SolveMode solveMode(const Params& params)
 {
   SolveMode mode = SolveMode::OnRequest;
@@ -187,7 +240,14 @@ std::string describe(const Params& p)
 {
   std::ostringstream out;
   out << "fdml_localizer configuration:\n"
-      << "  map_file: " << p.map_file << "\n"
+      << "  map_file: " << (p.map_file.empty() ? "(none)" : p.map_file)
+      << ", use_map_topic: " << (p.use_map_topic ? "true" : "false") << "\n"
+      << "  grid maps: map_simplify_tolerance: " << p.map_simplify_tolerance << " m (0 = one cell), map_min_area: "
+      << p.map_min_area << " m^2 (< 0 = ten cells), map_seed_point: "
+      << (p.map_seed_point.size() == 2
+              ? "[" + std::to_string(p.map_seed_point[0]) + ", " + std::to_string(p.map_seed_point[1]) + "]"
+              : std::string("(largest free region)"))
+      << ", map_occupied_threshold: " << p.map_occupied_threshold << "\n"
       << "  measurements_per_batch: " << p.measurements_per_batch << ", batch_stride: " << p.batch_stride
       << ", mode: " << p.mode << ", beams_per_scan: " << p.beams_per_scan << "\n"
       << "  transform_tolerance: " << p.transform_tolerance << " s, relocalize_timeout: " << p.relocalize_timeout
@@ -197,8 +257,10 @@ std::string describe(const Params& p)
       << "  topics: range " << p.range_topic << ", scan " << p.scan_topic << "\n"
       << "  engine: " << p.engine << ", method: " << p.method << ", resolution: " << p.resolution
       << ", theta_resolution: " << p.theta_resolution << ", min_inliers: " << p.min_inliers << "\n"
-      << "  agreement_tolerance: " << p.agreement_tolerance << " m, uniqueness_distance: " << p.uniqueness_distance
-      << " m, uniqueness_angle: " << p.uniqueness_angle << " rad, range_tolerance: " << p.range_tolerance << " m\n"
+      << "  agreement_tolerance: " << p.agreement_tolerance
+      << " m" << (p.agreement_tolerance_set ? "" : " (default)") << ", uniqueness_distance: " << p.uniqueness_distance
+      << " m, uniqueness_angle: " << p.uniqueness_angle << " rad, range_tolerance: " << p.range_tolerance << " m"
+      << (p.range_tolerance_set ? "" : " (default)") << "\n"
       << "  max_candidates: " << p.max_candidates << ", threads: " << p.threads << ", max_boxes: " << p.max_boxes
       << ", deadline: " << p.deadline << " s\n"
       << "  cache_dir: " << (p.cache_dir.empty() ? "(none)" : p.cache_dir);
@@ -209,6 +271,14 @@ Params loadParams(const ros::NodeHandle& nh)
 {
   Params p;
   nh.param("map_file", p.map_file, p.map_file);
+  nh.param("use_map_topic", p.use_map_topic, p.use_map_topic);
+  nh.param("map_simplify_tolerance", p.map_simplify_tolerance, p.map_simplify_tolerance);
+  nh.param("map_min_area", p.map_min_area, p.map_min_area);
+  if (nh.hasParam("map_seed_point") && !nh.getParam("map_seed_point", p.map_seed_point))
+  {
+    p.map_seed_point_malformed = true;
+  }
+  nh.param("map_occupied_threshold", p.map_occupied_threshold, p.map_occupied_threshold);
   nh.param("measurements_per_batch", p.measurements_per_batch, p.measurements_per_batch);
   nh.param("batch_stride", p.batch_stride, p.batch_stride);
   nh.param("mode", p.mode, p.mode);
@@ -227,9 +297,11 @@ Params loadParams(const ros::NodeHandle& nh)
   nh.param("resolution", p.resolution, p.resolution);
   nh.param("theta_resolution", p.theta_resolution, p.theta_resolution);
   nh.param("min_inliers", p.min_inliers, p.min_inliers);
+  p.agreement_tolerance_set = nh.hasParam("agreement_tolerance");
   nh.param("agreement_tolerance", p.agreement_tolerance, p.agreement_tolerance);
   nh.param("uniqueness_distance", p.uniqueness_distance, p.uniqueness_distance);
   nh.param("uniqueness_angle", p.uniqueness_angle, p.uniqueness_angle);
+  p.range_tolerance_set = nh.hasParam("range_tolerance");
   nh.param("range_tolerance", p.range_tolerance, p.range_tolerance);
   nh.param("max_candidates", p.max_candidates, p.max_candidates);
   nh.param("threads", p.threads, p.threads);

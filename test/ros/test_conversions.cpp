@@ -391,5 +391,85 @@ TEST(LocalizerConversions, ReadingMarkersDrawRaysFromThePoseColouredByInlier)
   EXPECT_EQ(array.markers[2].points.size(), 2u);  // hit points of the two returns
 }
 
+// ---------------------------------------------------------------------------------------------
+// nav_msgs/OccupancyGrid <-> core::OccupancyGrid (issue 9).
+// ---------------------------------------------------------------------------------------------
+
+TEST(Conversions, OccupancyGridMessageRoundTrip)
+{
+  core::OccupancyGrid grid;
+  grid.width = 7;
+  grid.height = 4;
+  grid.resolution = 0.25;  // exact in float32
+  grid.origin = core::Pose2(-1.5, 2.25, 0.7);
+  for (int i = 0; i < grid.width * grid.height; ++i)
+  {
+    grid.cells.push_back(static_cast<std::int8_t>(i % 3 == 0 ? -1 : (i * 13) % 101));
+  }
+  const nav_msgs::OccupancyGrid msg = toOccupancyGridMsg(grid, "map", ros::Time(3.0));
+  EXPECT_EQ(msg.header.frame_id, "map");
+  EXPECT_EQ(msg.header.stamp, ros::Time(3.0));
+  EXPECT_EQ(msg.info.width, 7u);
+  EXPECT_EQ(msg.info.height, 4u);
+  EXPECT_EQ(msg.info.resolution, 0.25f);
+  EXPECT_EQ(msg.info.origin.position.x, -1.5);
+  EXPECT_EQ(msg.info.origin.position.y, 2.25);
+  EXPECT_NEAR(msg.info.origin.orientation.z, std::sin(0.35), 1e-12);
+  EXPECT_NEAR(msg.info.origin.orientation.w, std::cos(0.35), 1e-12);
+  ASSERT_EQ(msg.data.size(), grid.cells.size());
+  for (std::size_t i = 0; i < grid.cells.size(); ++i)
+  {
+    EXPECT_EQ(msg.data[i], grid.cells[i]) << i;  // same layout: row-major, row 0 at the bottom
+  }
+
+  const core::OccupancyGrid back = fromOccupancyGridMsg(msg);
+  EXPECT_EQ(back.width, grid.width);
+  EXPECT_EQ(back.height, grid.height);
+  EXPECT_EQ(back.resolution, grid.resolution);
+  EXPECT_EQ(back.origin.x, grid.origin.x);
+  EXPECT_EQ(back.origin.y, grid.origin.y);
+  EXPECT_NEAR(back.origin.theta, grid.origin.theta, 1e-12);
+  EXPECT_EQ(back.cells, grid.cells);
+  EXPECT_TRUE(back.validate().empty());
+}
+
+TEST(Conversions, OccupancyGridMessageGeometry)
+{
+  // A message built by hand, as a SLAM node publishes it: cell (ix, iy) is data[iy * width + ix],
+  // its centre is origin (+) ((ix + 0.5) res, (iy + 0.5) res) with the origin's yaw applied.
+  nav_msgs::OccupancyGrid msg;
+  msg.info.width = 3;
+  msg.info.height = 2;
+  msg.info.resolution = 0.5f;
+  msg.info.origin.position.x = 1.0;
+  msg.info.origin.position.y = -2.0;
+  msg.info.origin.position.z = 0.3;  // ignored
+  // A yaw of pi/2 as a non-normalised quaternion (twice the unit one).
+  msg.info.origin.orientation.z = 2.0 * std::sin(core::kPi / 4.0);
+  msg.info.origin.orientation.w = 2.0 * std::cos(core::kPi / 4.0);
+  msg.data = { 0, 100, -1, 0, 0, 50 };
+  const core::OccupancyGrid grid = fromOccupancyGridMsg(msg);
+  EXPECT_TRUE(grid.validate().empty());
+  EXPECT_NEAR(grid.origin.theta, core::kPi / 2.0, 1e-12);
+  EXPECT_EQ(grid.at(1, 0), 100);
+  EXPECT_EQ(grid.at(2, 0), -1);
+  EXPECT_EQ(grid.at(2, 1), 50);
+  // Cell (2, 1): local centre (1.25, 0.75) rotated by pi/2 -> (-0.75, 1.25), plus the origin.
+  const core::Vec2 centre = grid.cellCentre(2, 1);
+  EXPECT_NEAR(centre.x(), 1.0 - 0.75, 1e-12);
+  EXPECT_NEAR(centre.y(), -2.0 + 1.25, 1e-12);
+  int ix = -1;
+  int iy = -1;
+  ASSERT_TRUE(grid.cellOf(centre, &ix, &iy));
+  EXPECT_EQ(ix, 2);
+  EXPECT_EQ(iy, 1);
+
+  // A data array of the wrong size is copied as is and reported by the core's validation.
+  msg.data.pop_back();
+  const std::vector<std::string> issues = fromOccupancyGridMsg(msg).validate();
+  ASSERT_EQ(issues.size(), 1u);
+  EXPECT_NE(issues[0].find("width * height"), std::string::npos) << issues[0];
+}
+
 }  // namespace
 }  // namespace fdml_localization

@@ -1,5 +1,5 @@
 // rostest: the fdml_localizer binary exits non-zero, naming the problem, for a missing map file,
-// an out-of-range parameter and a missing ~map_file (run as a child process against the
+// a map_server YAML whose image is missing, an out-of-range parameter and a missing ~map_file (run as a child process against the
 // rostest's master).
 #include <gtest/gtest.h>
 #include <ros/ros.h>
@@ -88,6 +88,36 @@ TEST(LocalizerBadParams, InvalidMapContentExitsNonZeroNamingTheLine)
   EXPECT_NE(run.exit_code, 0) << run.output;
   EXPECT_NE(run.exit_code, 124) << "timed out: " << run.output;
   EXPECT_NE(run.output.find(path + ":3"), std::string::npos) << run.output;
+}
+
+TEST(LocalizerBadParams, YamlWithAMissingImageExitsNonZeroNamingTheImage)
+{
+  const std::string stem = "/tmp/fdml_bad_yaml_" + std::to_string(::getpid());
+  const std::string path = stem + ".yaml";
+  FILE* file = std::fopen(path.c_str(), "w");
+  ASSERT_NE(file, nullptr);
+  std::fputs(("image: " + stem + "_missing.pgm\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\n"
+              "occupied_thresh: 0.65\nfree_thresh: 0.196\nnegate: 0\n")
+                 .c_str(),
+             file);
+  std::fclose(file);
+  const RunResult run = runNode("__name:=bad_yaml _map_file:=" + path);
+  std::remove(path.c_str());
+  EXPECT_NE(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.exit_code, 124) << "timed out: " << run.output;
+  EXPECT_NE(run.output.find(stem + "_missing.pgm"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("image file not found"), std::string::npos) << run.output;
+}
+
+TEST(LocalizerBadParams, BadGridConversionParametersExitNonZeroNamingThem)
+{
+  const RunResult run = runNode("__name:=bad_grid_params _use_map_topic:=true _map_simplify_tolerance:=-1 "
+                                "_map_occupied_threshold:=0");
+  EXPECT_NE(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.exit_code, 124) << "timed out: " << run.output;
+  EXPECT_NE(run.output.find("~map_simplify_tolerance = -1"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("~map_occupied_threshold = 0"), std::string::npos) << run.output;
+  EXPECT_EQ(run.output.find("~map_file is required"), std::string::npos) << run.output;
 }
 
 }  // namespace

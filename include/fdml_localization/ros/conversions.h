@@ -9,6 +9,7 @@
 #include "fdml_localization/core/ray_caster.h"
 #include "fdml_localization/core/scene.h"
 #include "fdml_localization/core/localizer.h"
+#include "fdml_localization/core/occupancy_grid.h"
 #include "fdml_localization/ros/reading_buffer.h"
 
 #include <fdml_localization/Candidate.h>
@@ -95,6 +96,18 @@ visualization_msgs::MarkerArray obstacleMarkers(const std::vector<core::Obstacle
  */
 nav_msgs::OccupancyGrid toOccupancyGrid(const core::MapRayCaster& caster, double resolution,
                                         const std::string& frame, const ros::Time& stamp);
+
+/**
+ * @brief A nav_msgs/OccupancyGrid as a core grid: sizes, resolution and cells copied unchanged
+ *        (both are row-major with row 0 at the bottom), the origin's position and its yaw (from
+ *        the quaternion, see quaternionToYaw()). A message whose data size does not match
+ *        width * height is copied as is: core::OccupancyGrid::validate() reports it.
+ */
+core::OccupancyGrid fromOccupancyGridMsg(const nav_msgs::OccupancyGrid& msg);
+
+/// A core grid as a nav_msgs/OccupancyGrid (origin at z = 0, yaw as a quaternion about +z).
+nav_msgs::OccupancyGrid toOccupancyGridMsg(const core::OccupancyGrid& grid, const std::string& frame,
+                                           const ros::Time& stamp);
 
 // ---------------------------------------------------------------------------------------------
 // Localizer node conversions (issue 6): covariance, readings, results, sensor input, rays.

@@ -11,6 +11,13 @@
  * - one worker thread owns the core::Localizer and solves: queued ~localize requests first, then
  *   the newest sensor batch (a newer batch replaces one still queued).
  *
+ * Maps: ~map_file (a .poly or a map_server .yaml, loaded before the node starts) and, with
+ * ~use_map_topic, nav_msgs/OccupancyGrid messages on `map` (as AMCL takes them). The map callback
+ * only stores the newest message; the worker converts it, builds a new core::Localizer (its
+ * tables) and swaps it in between two solves, so a new map takes effect atomically for the next
+ * solve. A grid that cannot be converted is logged and counted and the previous map stays in
+ * use. Until there is a map, ~relocalize and ~localize fail with "no map yet".
+ *
  * Relocalization (~relocalize, global_localization) clears the buffer and waits for k fresh
  * readings, each taken at its own stamp: the readings must differ, so the robot must rotate
  * in place (or drive) or the sensors must sweep while it waits. The readings' relative poses
@@ -25,6 +32,7 @@
 #pragma once
 
 #include "fdml_localization/core/localizer.h"
+#include "fdml_localization/ros/map_loading.h"
 #include "fdml_localization/ros/params.h"
 #include "fdml_localization/ros/reading_buffer.h"
 
@@ -33,6 +41,7 @@
 #include <fdml_localization/Relocalize.h>
 
 #include <diagnostic_updater/diagnostic_updater.h>
+#include <nav_msgs/OccupancyGrid.h>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <sensor_msgs/LaserScan.h>
@@ -71,11 +80,12 @@ public:
    * @param nh namespace of the input topics and of global_localization
    * @param private_nh namespace of the outputs, ~relocalize and ~localize
    * @param params validated parameters
-   * @param map the loaded map
+   * @param map the map loaded from ~map_file; its map may be null with ~use_map_topic (the node
+   *        then waits for one on the map topic)
    * @throws std::invalid_argument when the core rejects the options
    */
   LocalizerNode(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh, const Params& params,
-                std::shared_ptr<const core::MapRayCaster> map);
+                const LoadedMap& map);
   /// Fails waiting service calls, stops the spinners and joins the worker.
   ~LocalizerNode();
 
@@ -120,6 +130,19 @@ private:
   void workerLoop();
   Outcome solve(const Job& job);
 
+  // Maps (localizer_node_map.cpp).
+  /// Constructor step: the localizer of the ~map_file map (if any), the map topic subscription.
+  void setUpMaps(const LoadedMap& map);
+  void mapCallback(const nav_msgs::OccupancyGrid::ConstPtr& msg);
+  /// The core options for @p map: the parameters, with withGridTolerances() for a converted grid
+  /// (the effective tolerances are logged).
+  core::LocalizerOptions optionsFor(const LoadedMap& map) const;
+  /// Worker: converts @p msg, builds and prepares its localizer, and swaps both in; on failure
+  /// logs and counts the reason and keeps the previous map.
+  void applyMap(const nav_msgs::OccupancyGrid::ConstPtr& msg);
+  /// The answer of a request made before any map arrived.
+  std::string noMapMessage() const;
+
   // Outputs (localizer_node_publish.cpp).
   void publishBatchOutcome(const Job& job, const core::Result& result, const Outcome& outcome);
   void publishMapToOdom(const ros::WallTimerEvent& event);
@@ -128,8 +151,8 @@ private:
 
   Params params_;
   SolveMode mode_;
-  std::shared_ptr<const core::MapRayCaster> map_;
-  std::unique_ptr<core::Localizer> localizer_;  ///< used by the worker thread only
+  std::shared_ptr<const core::MapRayCaster> map_;  ///< null until a map; swapped by the worker only
+  std::unique_ptr<core::Localizer> localizer_;  ///< used by the worker thread only; null until a map
 
   ros::NodeHandle nh_;
   ros::NodeHandle private_nh_;
@@ -144,6 +167,7 @@ private:
 
   ros::Subscriber range_sub_;
   ros::Subscriber scan_sub_;
+  ros::Subscriber map_sub_;  ///< with ~use_map_topic only
   ros::Publisher candidates_pub_;
   ros::Publisher result_pub_;
   ros::Publisher pose_pub_;
@@ -177,6 +201,14 @@ private:
   bool last_unambiguous_ = false;
   std::string last_error_;
   std::string state_ = "starting";      ///< human-readable worker state
+  nav_msgs::OccupancyGrid::ConstPtr pending_map_;  ///< newest map message not yet taken by the worker
+  bool have_map_ = false;               ///< a map is in use (or will be, once the worker prepared it)
+  std::string map_source_;              ///< where the map in use came from
+  std::uint64_t maps_received_ = 0;     ///< map messages received
+  std::uint64_t maps_accepted_ = 0;     ///< map messages converted and in use
+  std::uint64_t maps_rejected_ = 0;     ///< map messages that could not be used
+  std::uint64_t maps_replaced_ = 0;     ///< map messages replaced by a newer one before conversion
+  std::string last_map_error_;
 
   std::thread worker_;  ///< started last, joined in the destructor
 };

@@ -5,6 +5,7 @@
  */
 #pragma once
 
+#include "fdml_localization/core/grid_to_polygon.h"
 #include "fdml_localization/core/localizer.h"
 
 #include <string>
@@ -32,7 +33,19 @@ const char* toString(SolveMode mode);
 struct Params
 {
   // Map and batching.
-  std::string map_file;              ///< ~map_file: .poly path, absolute or package://...; required
+  /// ~map_file: a .poly file or a map_server .yaml, absolute, file://... or package://...;
+  /// required unless use_map_topic (then optional: the map used until one arrives on the topic)
+  std::string map_file;
+  bool use_map_topic = false;        ///< ~use_map_topic: take nav_msgs/OccupancyGrid maps from `map`
+
+  // Occupancy grid -> polygon conversion (a .yaml ~map_file or the map topic).
+  double map_simplify_tolerance = 0.0;  ///< ~map_simplify_tolerance [m]: 0 = one cell, else (0, 10]
+  double map_min_area = -1.0;        ///< ~map_min_area [m^2]: obstacles smaller are specks; < 0 = ten cells
+  /// ~map_seed_point [m]: [x, y] in the map frame, keep the free region holding it; empty =
+  /// the largest free region. A malformed value is kept here as given (validate() reports it).
+  std::vector<double> map_seed_point;
+  bool map_seed_point_malformed = false;  ///< set by loadParams() when ~map_seed_point is not a list of numbers
+  int map_occupied_threshold = 50;   ///< ~map_occupied_threshold: cells >= this are walls, [1, 100]
   int measurements_per_batch = 10;   ///< ~measurements_per_batch: k, in [3, 255]
   int batch_stride = 1;              ///< ~batch_stride: readings the window slides by, in [1, k]
   std::string mode = "on_request";   ///< ~mode: on_request | continuous
@@ -58,9 +71,11 @@ struct Params
   int theta_resolution = 0;          ///< ~theta_resolution: 0 = resolution, else in [16, 1024]
   int min_inliers = 0;               ///< ~min_inliers: k', 0 = automatic, else in [3, k] (fixed for paper)
   double agreement_tolerance = 0.05; ///< ~agreement_tolerance [m]
+  bool agreement_tolerance_set = false;  ///< the user set ~agreement_tolerance (see withGridTolerances())
   double uniqueness_distance = 0.1;  ///< ~uniqueness_distance [m]
   double uniqueness_angle = 0.1;     ///< ~uniqueness_angle [rad]
   double range_tolerance = 0.02;     ///< ~range_tolerance [m]
+  bool range_tolerance_set = false;  ///< the user set ~range_tolerance (see withGridTolerances())
   int max_candidates = 10;           ///< ~max_candidates
   int threads = 0;                   ///< ~threads; 0 = all cores
   std::string cache_dir;             ///< ~cache_dir (expanded); empty = no disk cache
@@ -78,6 +93,18 @@ std::vector<std::string> validate(const Params& params);
 /// The core options from the parameters. Unknown engine/method names fall back to the defaults
 /// (validate() reports them).
 core::LocalizerOptions toLocalizerOptions(const Params& params);
+
+/// The grid conversion options from the ~map_* parameters.
+core::GridConversionOptions toGridOptions(const Params& params);
+
+/**
+ * @brief The parameters to use with a map converted from an occupancy grid of cells of
+ *        @p resolution [m]: the walls of such a map are only good to about a cell, so a
+ *        ~range_tolerance the user did not set becomes max(its default, resolution) and an
+ *        ~agreement_tolerance the user did not set max(its default, 2 * resolution).
+ *        Explicitly set values are kept. @p resolution <= 0 (a polygon map) changes nothing.
+ */
+Params withGridTolerances(const Params& params, double resolution);
 
 /// The parsed ~mode (OnRequest when invalid; validate() reports it).
 SolveMode solveMode(const Params& params);

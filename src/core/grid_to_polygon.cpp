@@ -294,21 +294,5 @@ PolygonMap gridToPolygon(const OccupancyGrid& grid, const GridConversionOptions&
   return PolygonMap::fromRings(std::move(simple), source);
 }
 
-PolygonMap loadMapFile(const std::string& path, const GridConversionOptions& options, GridConversionReport* report)
-{
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  if (ext == ".poly")
-  {
-    return loadPolyFile(path);
-  }
-  if (ext == ".yaml" || ext == ".yml")
-  {
-    return gridToPolygon(loadOccupancyGridYaml(path), options, path, report);
-  }
-  throw MapError(path, 0, "unknown map file type '" + ext +
-                              "' (allowed: .poly polygon files, .yaml/.yml map_server occupancy grids)");
-}
-
 }  // namespace core
 }  // namespace fdml_localization

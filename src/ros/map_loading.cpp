@@ -1,6 +1,7 @@
 #include "fdml_localization/ros/map_loading.h"
 
 #include "fdml_localization/ros/param_utils.h"
+#include "fdml_localization/io/map_files.h"
 
 #include <algorithm>
 #include <cctype>
@@ -76,14 +77,14 @@ LoadedMap loadMapFromFile(const std::string& location, const core::GridConversio
     if (isYamlPath(path))
     {
       // The grid's resolution is needed for the tolerances (withGridTolerances()): load it here,
-      // then convert as core::loadMapFile() does.
-      LoadedMap loaded = mapFromGrid(core::loadOccupancyGridYaml(path), options, path);
+      // then convert as io::loadMapFile() does.
+      LoadedMap loaded = mapFromGrid(io::loadOccupancyGridYaml(path), options, path);
       loaded.summary = path + ": " + loaded.summary;
       return loaded;
     }
     LoadedMap loaded;
     loaded.source = path;
-    loaded.map = std::make_shared<const core::MapRayCaster>(core::loadMapFile(path, options));
+    loaded.map = std::make_shared<const core::MapRayCaster>(io::loadMapFile(path, options));
     return loaded;
   }
   catch (const std::exception& error)

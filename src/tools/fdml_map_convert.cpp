@@ -10,6 +10,7 @@
 #include "fdml_localization/core/grid_to_polygon.h"
 #include "fdml_localization/core/text_parsing.h"
 #include "fdml_localization/core/map_io.h"
+#include "fdml_localization/io/map_files.h"
 
 #include <cmath>
 #include <filesystem>
@@ -21,6 +22,7 @@
 namespace
 {
 namespace core = fdml_localization::core;
+namespace io = fdml_localization::io;
 
 const char* kUsage =
     "usage: fdml_map_convert MAP.yaml OUT.poly [--tolerance M] [--min-area M2] [--seed-point X,Y]\n"
@@ -144,7 +146,7 @@ int main(int argc, char** argv)
   core::GridConversionReport report;
   try
   {
-    grid = core::loadOccupancyGridYaml(args.input);
+    grid = io::loadOccupancyGridYaml(args.input);
     map = core::gridToPolygon(grid, args.options, args.input, &report);
   }
   catch (const std::exception& e)
@@ -161,7 +163,7 @@ int main(int argc, char** argv)
     core::savePolyFile(args.output, map, comment.str());
     if (args.preview)
     {
-      core::writePreviewPng(png, grid, map);
+      io::writePreviewPng(png, grid, map);
     }
   }
   catch (const std::exception& e)

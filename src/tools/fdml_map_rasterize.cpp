@@ -10,6 +10,7 @@
 #include "fdml_localization/core/grid_to_polygon.h"
 #include "fdml_localization/core/text_parsing.h"
 #include "fdml_localization/core/map_io.h"
+#include "fdml_localization/io/map_files.h"
 
 #include <cmath>
 #include <iostream>
@@ -19,6 +20,7 @@
 namespace
 {
 namespace core = fdml_localization::core;
+namespace io = fdml_localization::io;
 
 const char* kUsage =
     "usage: fdml_map_rasterize IN.poly OUT.yaml [--resolution M] [--margin M] [--wall M]\n"
@@ -120,7 +122,7 @@ int main(int argc, char** argv)
   {
     const core::PolygonMap map = core::loadPolyFile(input);
     const core::OccupancyGrid grid = core::rasterize(map, options);
-    core::saveOccupancyGridYaml(output, grid);
+    io::saveOccupancyGridYaml(output, grid);
     std::cout << input << " -> " << output << ": " << grid.width << " x " << grid.height << " cells at "
               << grid.resolution << " m\n";
   }

@@ -3,6 +3,7 @@
 #include "fdml_localization/core/grid_to_polygon.h"
 #include "fdml_localization/core/localizer.h"
 #include "fdml_localization/core/map_io.h"
+#include "fdml_localization/io/map_files.h"
 
 #include <gtest/gtest.h>
 
@@ -14,6 +15,7 @@
 #include <vector>
 
 namespace core = fdml_localization::core;
+namespace io = fdml_localization::io;
 
 namespace
 {
@@ -77,7 +79,7 @@ TEST(GridLocalization, ConvertedShippedGridLocalizesAsWellAsTheOriginalMap)
 {
   const std::string dir = std::string(FDML_SOURCE_DIR) + "/maps/";
   const auto original = std::make_shared<const core::MapRayCaster>(core::loadPolyFile(dir + "office.poly"));
-  const auto converted = std::make_shared<const core::MapRayCaster>(core::loadMapFile(dir + "office_grid.yaml"));
+  const auto converted = std::make_shared<const core::MapRayCaster>(io::loadMapFile(dir + "office_grid.yaml"));
   ASSERT_EQ(converted->map().holeCount(), original->map().holeCount());
 
   core::LocalizerOptions options;

@@ -3,6 +3,7 @@
 #include "fdml_localization/core/grid_to_polygon.h"
 #include "fdml_localization/core/map_io.h"
 #include "fdml_localization/core/ray_caster.h"
+#include "fdml_localization/io/map_files.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -16,6 +17,7 @@
 
 namespace fs = std::filesystem;
 namespace core = fdml_localization::core;
+namespace io = fdml_localization::io;
 using core::Vec2;
 
 namespace
@@ -423,9 +425,9 @@ TEST(GridToPolygon, LoadMapFileDispatchesOnTheExtension)
   fs::create_directories(dir);
   const core::PolygonMap office = officeMap();
   core::savePolyFile((dir / "office.poly").string(), office);
-  core::saveOccupancyGridYaml((dir / "office.yaml").string(), core::rasterize(office, {}));
-  const core::PolygonMap from_poly = core::loadMapFile((dir / "office.poly").string());
-  const core::PolygonMap from_yaml = core::loadMapFile((dir / "office.yaml").string());
+  io::saveOccupancyGridYaml((dir / "office.yaml").string(), core::rasterize(office, {}));
+  const core::PolygonMap from_poly = io::loadMapFile((dir / "office.poly").string());
+  const core::PolygonMap from_yaml = io::loadMapFile((dir / "office.yaml").string());
   fs::remove_all(dir);
   EXPECT_EQ(from_poly.hash(), office.hash());
   EXPECT_EQ(from_yaml.holeCount(), office.holeCount());
@@ -454,7 +456,7 @@ TEST(ShippedGrids, AreReproducibleFromTheirPolygonsAndConvertBack)
     raster.islands = m.islands;
     raster.seed = m.seed;
     const core::OccupancyGrid made = core::rasterize(original, raster);
-    const core::OccupancyGrid shipped = core::loadOccupancyGridYaml(base + "_grid.yaml");
+    const core::OccupancyGrid shipped = io::loadOccupancyGridYaml(base + "_grid.yaml");
     EXPECT_EQ(shipped.width, made.width) << m.name;
     EXPECT_EQ(shipped.height, made.height) << m.name;
     EXPECT_EQ(shipped.cells, made.cells) << m.name;

@@ -2,6 +2,7 @@
 #include "fdml_localization/core/grid_to_polygon.h"
 #include "fdml_localization/core/map_io.h"
 #include "fdml_localization/core/occupancy_grid.h"
+#include "fdml_localization/io/map_files.h"
 
 #include <gtest/gtest.h>
 #include <stb/stb_image_write.h>
@@ -16,6 +17,7 @@
 
 namespace fs = std::filesystem;
 namespace core = fdml_localization::core;
+namespace io = fdml_localization::io;
 
 namespace
 {
@@ -150,7 +152,7 @@ TEST(MapYaml, ParsesEveryKeyAndResolvesTheImageBesideTheYaml)
 {
   TempDir dir;
   dir.write("a.yaml", std::string(kValidYaml) + "mode: scale\n");
-  const core::MapYaml m = core::loadMapYamlFile(dir.file("a.yaml"));
+  const core::MapYaml m = io::loadMapYamlFile(dir.file("a.yaml"));
   EXPECT_EQ(m.image, "map.pgm");
   EXPECT_EQ(fs::path(m.image_path), fs::path(dir.file("map.pgm")));
   EXPECT_DOUBLE_EQ(m.resolution, 0.1);
@@ -164,7 +166,7 @@ TEST(MapYaml, ParsesEveryKeyAndResolvesTheImageBesideTheYaml)
 
   dir.write("b.yaml", "image: /abs/x.png\nresolution: 1\norigin: [0, 0, 0]\nnegate: true\n"
                       "occupied_thresh: 0.9\nfree_thresh: 0.1\n");
-  const core::MapYaml b = core::loadMapYamlFile(dir.file("b.yaml"));
+  const core::MapYaml b = io::loadMapYamlFile(dir.file("b.yaml"));
   EXPECT_EQ(b.image_path, "/abs/x.png");
   EXPECT_TRUE(b.negate);
   EXPECT_EQ(b.mode, core::MapMode::Trinary);
@@ -182,9 +184,9 @@ TEST(MapYaml, SaveAndLoadRoundTripThroughPgm)
   {
     g.cells.push_back(static_cast<std::int8_t>(i % 3 == 0 ? 0 : (i % 3 == 1 ? 100 : -1)));
   }
-  core::saveOccupancyGridYaml(dir.file("g.yaml"), g);
+  io::saveOccupancyGridYaml(dir.file("g.yaml"), g);
   ASSERT_TRUE(fs::exists(dir.file("g.pgm")));
-  const core::OccupancyGrid back = core::loadOccupancyGridYaml(dir.file("g.yaml"));
+  const core::OccupancyGrid back = io::loadOccupancyGridYaml(dir.file("g.yaml"));
   EXPECT_EQ(back.width, g.width);
   EXPECT_EQ(back.height, g.height);
   EXPECT_DOUBLE_EQ(back.resolution, g.resolution);
@@ -202,7 +204,7 @@ TEST(MapYaml, LoadsPngWithNegate)
   ASSERT_TRUE(stbi_write_png(dir.file("m.png").c_str(), 3, 1, 3, rgb, 9));
   dir.write("m.yaml", "image: m.png\nresolution: 0.2\norigin: [0, 0, 0]\nnegate: 1\n"
                       "occupied_thresh: 0.65\nfree_thresh: 0.196\n");
-  const core::OccupancyGrid g = core::loadOccupancyGridYaml(dir.file("m.yaml"));
+  const core::OccupancyGrid g = io::loadOccupancyGridYaml(dir.file("m.yaml"));
   ASSERT_EQ(g.width, 3);
   EXPECT_EQ(g.at(0, 0), 0);
   EXPECT_EQ(g.at(1, 0), 100);
@@ -259,7 +261,7 @@ TEST(BadGridInput, MissingImageNamesTheImageAndTheYaml)
 {
   TempDir dir;
   dir.write("a.yaml", kValidYaml);
-  expectMapError([&] { core::loadOccupancyGridYaml(dir.file("a.yaml")); },
+  expectMapError([&] { io::loadOccupancyGridYaml(dir.file("a.yaml")); },
                  { dir.file("map.pgm"), "not found", "a.yaml" });
 }
 
@@ -268,14 +270,14 @@ TEST(BadGridInput, UnreadableImageNamesTheImage)
   TempDir dir;
   dir.write("a.yaml", kValidYaml);
   dir.write("map.pgm", "this is not an image at all");
-  expectMapError([&] { core::loadOccupancyGridYaml(dir.file("a.yaml")); },
+  expectMapError([&] { io::loadOccupancyGridYaml(dir.file("a.yaml")); },
                  { dir.file("map.pgm"), "cannot decode" });
 }
 
 TEST(BadGridInput, MissingYamlFile)
 {
   TempDir dir;
-  expectMapError([&] { core::loadOccupancyGridYaml(dir.file("none.yaml")); }, { "none.yaml", "cannot open" });
+  expectMapError([&] { io::loadOccupancyGridYaml(dir.file("none.yaml")); }, { "none.yaml", "cannot open" });
 }
 
 TEST(BadGridInput, EachMissingKeyIsNamed)
@@ -294,7 +296,7 @@ TEST(BadGridInput, EachMissingKeyIsNamed)
       }
     }
     dir.write(key + ".yaml", text);
-    expectMapError([&] { core::loadMapYamlFile(dir.file(key + ".yaml")); },
+    expectMapError([&] { io::loadMapYamlFile(dir.file(key + ".yaml")); },
                    { key + ".yaml", "missing key '" + key + "'" });
   }
 }
@@ -304,19 +306,19 @@ TEST(BadGridInput, BadValuesNameTheKeyAndLine)
   TempDir dir;
   dir.write("r.yaml", "image: m.pgm\nresolution: -0.05\norigin: [0, 0, 0]\nnegate: 0\n"
                       "occupied_thresh: 0.65\nfree_thresh: 0.196\n");
-  expectMapError([&] { core::loadMapYamlFile(dir.file("r.yaml")); }, { "r.yaml:2", "resolution", "> 0" });
+  expectMapError([&] { io::loadMapYamlFile(dir.file("r.yaml")); }, { "r.yaml:2", "resolution", "> 0" });
   dir.write("o.yaml", "image: m.pgm\nresolution: 0.05\norigin: [0, 0]\nnegate: 0\n"
                       "occupied_thresh: 0.65\nfree_thresh: 0.196\n");
-  expectMapError([&] { core::loadMapYamlFile(dir.file("o.yaml")); }, { "o.yaml:3", "origin", "[x, y, yaw]" });
+  expectMapError([&] { io::loadMapYamlFile(dir.file("o.yaml")); }, { "o.yaml:3", "origin", "[x, y, yaw]" });
   dir.write("m.yaml", std::string(kValidYaml) + "mode: fancy\n");
-  expectMapError([&] { core::loadMapYamlFile(dir.file("m.yaml")); }, { "m.yaml:7", "mode", "trinary, scale, raw" });
+  expectMapError([&] { io::loadMapYamlFile(dir.file("m.yaml")); }, { "m.yaml:7", "mode", "trinary, scale, raw" });
   dir.write("t.yaml", "image: m.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\n"
                       "occupied_thresh: 0.2\nfree_thresh: 0.6\n");
-  expectMapError([&] { core::loadMapYamlFile(dir.file("t.yaml")); }, { "t.yaml:6", "free_thresh" });
+  expectMapError([&] { io::loadMapYamlFile(dir.file("t.yaml")); }, { "t.yaml:6", "free_thresh" });
   dir.write("s.yaml", "image: [unclosed\nresolution: 0.05\n");
-  expectMapError([&] { core::loadMapYamlFile(dir.file("s.yaml")); }, { "s.yaml", "YAML syntax error" });
+  expectMapError([&] { io::loadMapYamlFile(dir.file("s.yaml")); }, { "s.yaml", "YAML syntax error" });
   dir.write("n.yaml", "just a sentence\n");
-  expectMapError([&] { core::loadMapYamlFile(dir.file("n.yaml")); }, { "n.yaml", "not a map_server YAML" });
+  expectMapError([&] { io::loadMapYamlFile(dir.file("n.yaml")); }, { "n.yaml", "not a map_server YAML" });
 }
 
 TEST(BadGridInput, AllOccupiedMapHasNoFreeSpace)
@@ -327,8 +329,8 @@ TEST(BadGridInput, AllOccupiedMapHasNoFreeSpace)
   g.height = 10;
   g.cells.assign(200, 100);
   g.cells[5] = -1;
-  core::saveOccupancyGridYaml(dir.file("walls.yaml"), g);
-  expectMapError([&] { core::loadMapFile(dir.file("walls.yaml")); }, { "walls.yaml", "no free cell" });
+  io::saveOccupancyGridYaml(dir.file("walls.yaml"), g);
+  expectMapError([&] { io::loadMapFile(dir.file("walls.yaml")); }, { "walls.yaml", "no free cell" });
 }
 
 TEST(BadGridInput, SeedPointOutsideOrInAWall)
@@ -355,5 +357,5 @@ TEST(BadGridInput, SeedPointOutsideOrInAWall)
 
 TEST(BadGridInput, UnknownMapExtension)
 {
-  expectMapError([] { core::loadMapFile("maps/office.png"); }, { "office.png", "unknown map file type" });
+  expectMapError([] { io::loadMapFile("maps/office.png"); }, { "office.png", "unknown map file type" });
 }

@@ -63,14 +63,6 @@ struct GridConversionReport
 PolygonMap gridToPolygon(const OccupancyGrid& grid, const GridConversionOptions& options = {},
                          const std::string& source = "<grid>", GridConversionReport* report = nullptr);
 
-/**
- * @brief Loads any map file: `.poly` (loadPolyFile) or a map_server `.yaml` / `.yml`
- *        (loadOccupancyGridYaml, then gridToPolygon with @p options).
- * @throws MapError naming the file and the problem (also for an unknown extension).
- */
-PolygonMap loadMapFile(const std::string& path, const GridConversionOptions& options = {},
-                       GridConversionReport* report = nullptr);
-
 /// Options of rasterize().
 struct RasterizeOptions
 {
@@ -90,14 +82,6 @@ struct RasterizeOptions
  * @throws std::invalid_argument naming the option out of range, or for an empty map.
  */
 OccupancyGrid rasterize(const PolygonMap& map, const RasterizeOptions& options);
-
-/**
- * @brief Writes a PNG preview: the grid in grey (free white, occupied black, unknown grey),
- *        the polygon's outer ring in blue and its holes in red drawn over it. Small grids are
- *        scaled up (an integer factor, at most 8) to about 1200 pixels along the longer side.
- * @throws std::runtime_error naming the file when it cannot be written.
- */
-void writePreviewPng(const std::string& path, const OccupancyGrid& grid, const PolygonMap& map);
 
 }  // namespace core
 }  // namespace fdml_localization

@@ -79,13 +79,6 @@ struct MapYaml
 };
 
 /**
- * @brief Reads a map_server YAML file. Required keys: image, resolution, origin,
- *        occupied_thresh, free_thresh, negate (as map_server requires); optional: mode.
- * @throws MapError naming the file, the line when known, the key and the problem.
- */
-MapYaml loadMapYamlFile(const std::string& path);
-
-/**
  * @brief Converts decoded pixels to cells with map_server's semantics: the mean of the
  *        colour channels (alpha excluded unless trinary), negated when asked, gives
  *        p = (255 - value) / 255; p > occupied_thresh -> 100, p < free_thresh -> 0, else
@@ -97,23 +90,6 @@ MapYaml loadMapYamlFile(const std::string& path);
  */
 OccupancyGrid pixelsToGrid(const std::uint8_t* pixels, int width, int height, int channels,
                            const MapYaml& meta);
-
-/// Loads a map_server map (YAML + image). @throws MapError naming the file and the problem.
-OccupancyGrid loadOccupancyGridYaml(const std::string& yaml_path);
-
-/**
- * @brief Writes the grid as a binary PGM the way map_saver does: free (0) -> 254,
- *        occupied (>= 65) -> 0, anything else -> 205 (unknown), top row first.
- * @throws std::runtime_error naming the file when it cannot be written.
- */
-void writePgm(const std::string& path, const OccupancyGrid& grid);
-
-/**
- * @brief Saves the grid as a map_server map: @p yaml_path plus a PGM beside it (same stem),
- *        trinary mode, occupied_thresh 0.65, free_thresh 0.196, negate 0.
- * @throws std::runtime_error naming the file when it cannot be written.
- */
-void saveOccupancyGridYaml(const std::string& yaml_path, const OccupancyGrid& grid);
 
 }  // namespace core
 }  // namespace fdml_localization

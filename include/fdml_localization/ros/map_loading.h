@@ -41,7 +41,7 @@ struct LoadedMap
 std::string resolveMapPath(const std::string& location);
 
 /**
- * @brief Loads the map named by @p location (see resolveMapPath()) with core::loadMapFile():
+ * @brief Loads the map named by @p location (see resolveMapPath()) with io::loadMapFile():
  *        a `.poly` file, or a map_server `.yaml` / `.yml` converted with @p options.
  * @throws MapLoadError naming ~map_file, the file (the image for a missing image), the line
  *         when known, and the problem.

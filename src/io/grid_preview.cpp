@@ -1,4 +1,4 @@
-#include "fdml_localization/core/grid_to_polygon.h"
+#include "fdml_localization/io/map_files.h"
 
 #include <stb/stb_image_write.h>
 
@@ -9,8 +9,13 @@
 
 namespace fdml_localization
 {
-namespace core
+namespace io
 {
+using core::OccupancyGrid;
+using core::PolygonMap;
+using core::Vec2;
+using core::Ring;
+
 namespace
 {
 using Rgb = std::array<std::uint8_t, 3>;
@@ -107,5 +112,5 @@ void writePreviewPng(const std::string& path, const OccupancyGrid& grid, const P
   }
 }
 
-}  // namespace core
+}  // namespace io
 }  // namespace fdml_localization

@@ -477,9 +477,13 @@ TEST(LocalizerInput, BadInputIsAClearError)
   LocalizerOptions paper = options;
   paper.method = Method::Paper;
   EXPECT_THROW(Localizer(map, paper), std::invalid_argument);
+  // The adaptive engine allows resolutions above the voxel engine's limit.
   LocalizerOptions adaptive = options;
   adaptive.engine = Engine::Adaptive;
-  EXPECT_THROW(Localizer(map, adaptive), std::invalid_argument);
+  adaptive.resolution = 2000;
+  EXPECT_TRUE(validate(adaptive).empty());
+  adaptive.resolution = kMaxAdaptiveResolution + 1;
+  EXPECT_EQ(validate(adaptive).size(), 1u);
   EXPECT_THROW(Localizer(std::make_shared<const MapRayCaster>(), options), std::invalid_argument);
   EXPECT_TRUE(validate(LocalizerOptions()).empty());
 }

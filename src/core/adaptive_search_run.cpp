@@ -187,7 +187,15 @@ const AdaptiveSearchResult& AdaptiveSearch::run(int min_count)
   {
     // Boxes set aside by earlier runs whose upper bound reaches the new k'.
     std::vector<Node>& aside = set_aside_[level];
-    const auto resumed = std::partition(aside.begin(), aside.end(), [&](const Node& n) { return n.count < min_count; });
+    auto resumed = std::partition(aside.begin(), aside.end(), [&](const Node& n) { return n.count < min_count; });
+    // Within the box budget only: the rest stays aside and the search ends after this level.
+    const long room = std::max(0L, options_.max_boxes - result_.boxes_tested - static_cast<long>(current.size()));
+    bool cut = false;
+    if (aside.end() - resumed > room)
+    {
+      resumed = aside.end() - room;
+      cut = true;
+    }
     current.insert(current.end(), resumed, aside.end());
     aside.erase(resumed, aside.end());
     prepareArcs(level);
@@ -226,12 +234,12 @@ const AdaptiveSearchResult& AdaptiveSearch::run(int min_count)
     const int sx = split(lx_), sy = split(ly_), st = split(lt_);
     const long children = static_cast<long>(survivors.size()) * sx * sy * st;
     elapsed_ = std::chrono::duration<double>(Clock::now() - start_).count();
-    const bool out_of_budget = !last && (result_.boxes_tested + children > options_.max_boxes ||
-                                         (options_.deadline > 0.0 && elapsed_ > options_.deadline));
+    const bool out_of_budget = cut || (!last && (result_.boxes_tested + children > options_.max_boxes ||
+                                                  (options_.deadline > 0.0 && elapsed_ > options_.deadline)));
     if (last || out_of_budget)
     {
       // A cut search reports the boxes of the last full level as its leaves and stops for good.
-      result_.truncated = out_of_budget && !survivors.empty();
+      result_.truncated = out_of_budget && (cut || !survivors.empty());
       finished_ = out_of_budget;
       for (const Node& n : survivors)
       {

@@ -255,6 +255,28 @@ TEST(AdaptiveSearch, BoxBudgetCutsTheSearchAndSaysSo)
   EXPECT_TRUE(keepsTruth(result, q));
 }
 
+TEST(AdaptiveSearch, ResumedSearchStaysWithinTheBoxBudget)
+{
+  const auto map = test::loadMap("maps/office.poly");
+  const BoxOccupancy occupancy(*map, 0.1);
+  std::mt19937_64 rng(19);
+  const Pose2 q = anyFreePose(*map, rng);
+  std::vector<Reading> readings = turnInPlace(*map, q, 10, 0.0, rng);
+  readings[4].range *= 0.5;
+  AdaptiveSearchOptions options;
+  options.cell_xy = 0.1;
+  options.cell_theta = kTwoPi / 128.0;
+  options.floor_count = 3;
+  const long first = AdaptiveSearch(*map, occupancy, readings, options).run(10).boxes_tested;
+  options.max_boxes = first + 200;
+  AdaptiveSearch search(*map, occupancy, readings, options);
+  EXPECT_FALSE(search.run(10).truncated);
+  const AdaptiveSearchResult& result = search.run(3);
+  EXPECT_TRUE(result.truncated);
+  EXPECT_LE(result.boxes_tested, options.max_boxes);
+  EXPECT_EQ(search.run(3).boxes_tested, result.boxes_tested);  // a cut search stays cut
+}
+
 TEST(AdaptiveSearch, DeadlineCutsTheSearchAndSaysSo)
 {
   const auto map = test::loadMap("maps/warehouse.poly");

@@ -36,6 +36,7 @@ BoxOccupancy::BoxOccupancy(const MapRayCaster& map, double cell_size, int max_ce
   const Vec2 size = bounds_.size();
   const double longest = std::max({ size.x(), size.y(), 1e-9 });
   cell_ = std::max(cell_size, longest / std::max(1, max_cells_per_side));
+  inv_cell_ = 1.0 / cell_;
   nx_ = std::max(1, static_cast<int>(std::ceil(size.x() / cell_)));
   ny_ = std::max(1, static_cast<int>(std::ceil(size.y() / cell_)));
   std::vector<std::uint8_t> edge(static_cast<std::size_t>(nx_) * ny_, 0);
@@ -120,13 +121,20 @@ std::int64_t BoxOccupancy::count(const std::vector<std::int32_t>& table, const B
   }
   // Edges within a rounding margin of a cell border are marked on both sides, so the cells
   // holding the box's corners suffice.
-  const int x0 = std::clamp(static_cast<int>(std::floor((box.min.x() - bounds_.min.x()) / cell_)), 0, nx_ - 1);
-  const int x1 = std::clamp(static_cast<int>(std::floor((box.max.x() - bounds_.min.x()) / cell_)), 0, nx_ - 1);
-  const int y0 = std::clamp(static_cast<int>(std::floor((box.min.y() - bounds_.min.y()) / cell_)), 0, ny_ - 1);
-  const int y1 = std::clamp(static_cast<int>(std::floor((box.max.y() - bounds_.min.y()) / cell_)), 0, ny_ - 1);
+  const int x0 = cellIndex(box.min.x() - bounds_.min.x(), nx_);
+  const int x1 = cellIndex(box.max.x() - bounds_.min.x(), nx_);
+  const int y0 = cellIndex(box.min.y() - bounds_.min.y(), ny_);
+  const int y1 = cellIndex(box.max.y() - bounds_.min.y(), ny_);
   const std::size_t w = static_cast<std::size_t>(nx_) + 1;
   return static_cast<std::int64_t>(table[(y1 + 1) * w + x1 + 1]) - table[(y1 + 1) * w + x0] -
          table[y0 * w + x1 + 1] + table[y0 * w + x0];
+}
+
+int BoxOccupancy::cellIndex(double offset, int cells) const
+{
+  // Clamped in floating point first (offsets may be far outside), then truncated (>= 0).
+  const double c = std::min(std::max(offset * inv_cell_, 0.0), static_cast<double>(cells - 1));
+  return static_cast<int>(c);
 }
 
 bool BoxOccupancy::mayTouchEdge(const Box2& box) const

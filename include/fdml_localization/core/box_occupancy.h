@@ -45,8 +45,12 @@ private:
   /// Number of marked cells in the clamped cell range covering the box (0 when outside).
   std::int64_t count(const std::vector<std::int32_t>& table, const Box2& box) const;
 
+  /// Cell index along an axis of an offset from the bounds' minimum [m], clamped to [0, cells).
+  int cellIndex(double offset, int cells) const;
+
   Box2 bounds_;
   double cell_ = 1.0;
+  double inv_cell_ = 1.0;
   int nx_ = 0;
   int ny_ = 0;
   std::vector<std::int32_t> edge_sum_;  ///< summed-area table of edge cells, (nx+1) x (ny+1)

@@ -20,6 +20,8 @@ constexpr long kRetriedSeeds = 32;
 constexpr long kLocallySearchedSeeds = 8;
 /// Distinct seeds taken from one plateau.
 constexpr std::size_t kSeedsPerPlateau = 3;
+/// ... from plateaus of at least this many leaves (smaller ones give one seed).
+constexpr std::size_t kLargePlateau = 16;
 
 double secondsSince(std::chrono::steady_clock::time_point start)
 {
@@ -203,7 +205,8 @@ void AdaptiveEngine::localizeRobust(AdaptiveSearch& search, const std::vector<Re
     for (long c = 0; c < static_cast<long>(plateaus.size()); ++c)
     {
       plateau_seeds[c] = plateauSeeds(*map_, found.leaves, plateaus[c], readings, loose_gate, 4.0 * cell_xy_,
-                                      4.0 * cell_theta_, kSeedsPerPlateau);
+                                      4.0 * cell_theta_,
+                                      plateaus[c].members.size() >= kLargePlateau ? kSeedsPerPlateau : 1);
     }
     std::vector<LeafCluster> maxima;
     for (std::size_t c = 0; c < plateaus.size(); ++c)

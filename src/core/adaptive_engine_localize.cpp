@@ -4,6 +4,8 @@
 
 #include "fdml_localization/core/candidate_refinement.h"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -143,6 +145,7 @@ void AdaptiveEngine::localizeFixed(AdaptiveSearch& search, const std::vector<Rea
                                    Result& result)
 {
   const std::int64_t theta_cells = std::max<std::int64_t>(1, std::llround(kTwoPi / cell_theta_));
+  const int threads = options_.threads > 0 ? options_.threads : omp_get_max_threads();
   auto stage = std::chrono::steady_clock::now();
   const AdaptiveSearchResult& found = search.run(level);
   result.times.preimages += secondsSince(stage);
@@ -151,7 +154,7 @@ void AdaptiveEngine::localizeFixed(AdaptiveSearch& search, const std::vector<Rea
   result.times.components += secondsSince(stage);
   stage = std::chrono::steady_clock::now();
   std::vector<Candidate> candidates(clusters.size());
-#pragma omp parallel for schedule(dynamic, 1) if (clusters.size() >= 4)
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (clusters.size() >= 4)
   for (long c = 0; c < static_cast<long>(clusters.size()); ++c)
   {
     candidates[c] = verifiedCandidate(*map_, clusters[c].centroid, readings, options_.agreement_tolerance);
@@ -177,6 +180,7 @@ void AdaptiveEngine::localizeRobust(AdaptiveSearch& search, const std::vector<Re
   const bool automatic = options_.min_inliers <= 0;
   const int lowest = automatic ? 3 : options_.min_inliers;
   const std::int64_t theta_cells = std::max<std::int64_t>(1, std::llround(kTwoPi / cell_theta_));
+  const int threads = options_.threads > 0 ? options_.threads : omp_get_max_threads();
 
   RefinementSettings settings;
   settings.agreement_tolerance = options_.agreement_tolerance;
@@ -201,7 +205,7 @@ void AdaptiveEngine::localizeRobust(AdaptiveSearch& search, const std::vector<Re
     // Seeds: the best-agreeing distinct leaves of each plateau (a copy of the plateau per seed).
     stage = std::chrono::steady_clock::now();
     std::vector<std::vector<Pose2>> plateau_seeds(plateaus.size());
-#pragma omp parallel for schedule(dynamic, 1) if (plateaus.size() >= 4)
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (plateaus.size() >= 4)
     for (long c = 0; c < static_cast<long>(plateaus.size()); ++c)
     {
       plateau_seeds[c] = plateauSeeds(*map_, found.leaves, plateaus[c], readings, loose_gate, 4.0 * cell_xy_,
@@ -225,7 +229,7 @@ void AdaptiveEngine::localizeRobust(AdaptiveSearch& search, const std::vector<Re
     std::vector<char> plausible(maxima.size(), 0);
     std::vector<Pose2> starts(maxima.size());
     stage = std::chrono::steady_clock::now();
-#pragma omp parallel for schedule(dynamic, 1) if (maxima.size() >= 4)
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (maxima.size() >= 4)
     for (long c = 0; c < static_cast<long>(maxima.size()); ++c)
     {
       hypotheses[c] = hypothesisOf(found.leaves[maxima[c].representative], readings.size());
@@ -239,7 +243,7 @@ void AdaptiveEngine::localizeRobust(AdaptiveSearch& search, const std::vector<Re
     RefinementSettings level_settings = settings;
     level_settings.escape_min_inliers = std::max(3, level - 1);
     level_settings.target_inliers = level;
-#pragma omp parallel for schedule(dynamic, 1) if (maxima.size() >= 4)
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (maxima.size() >= 4)
     for (long c = 0; c < static_cast<long>(maxima.size()); ++c)
     {
       if (plausible[c])
@@ -254,7 +258,7 @@ void AdaptiveEngine::localizeRobust(AdaptiveSearch& search, const std::vector<Re
     if (!reached)
     {
       const long retried = std::min<long>(static_cast<long>(maxima.size()), kRetriedSeeds);
-#pragma omp parallel for schedule(dynamic, 1) if (retried >= 4)
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (retried >= 4)
       for (long c = 0; c < retried; ++c)
       {
         Candidate& seed = seeds[first + c];

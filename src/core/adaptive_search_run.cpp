@@ -46,9 +46,11 @@ AdaptiveSearch::AdaptiveSearch(const MapRayCaster& map, const BoxOccupancy& occu
   : map_(map), occupancy_(occupancy), readings_(std::move(readings)), options_(options), start_(Clock::now())
 {
   const Box2& bounds = map_.map().bounds();
-  nx_ = std::max<std::int64_t>(1, std::ceil(bounds.size().x() / options_.cell_xy));
-  ny_ = std::max<std::int64_t>(1, std::ceil(bounds.size().y() / options_.cell_xy));
-  nt_ = std::max<std::int64_t>(1, std::ceil(kTwoPi / options_.cell_theta));
+  // Cell counts; a ratio within rounding of an integer (cell = size / n) gives exactly n cells.
+  auto cells = [](double ratio) { return std::max<std::int64_t>(1, std::ceil(ratio * (1.0 - 1e-12))); };
+  nx_ = cells(bounds.size().x() / options_.cell_xy);
+  ny_ = cells(bounds.size().y() / options_.cell_xy);
+  nt_ = cells(kTwoPi / options_.cell_theta);
   cell_t_ = kTwoPi / static_cast<double>(nt_);
   lx_ = levelsFor(nx_);
   ly_ = levelsFor(ny_);

@@ -4,6 +4,8 @@
 REPO_DIR="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 WS="${WS:-$REPO_DIR/ws}"
 JOBS="${JOBS:-$(nproc)}"
+# ROS tools run under the first python3 on PATH; Debian's has the ROS modules (rospkg, ...).
+export PATH="/usr/bin:$PATH"
 export ROS_HOME="${ROS_HOME:-$WS/ros_home}"
 export ROS_LOG_DIR="${ROS_LOG_DIR:-$ROS_HOME/log}"
 

@@ -1,5 +1,56 @@
 #!/usr/bin/env bash
-# The package's main job, headless: an interim core demo until the simulator and node land.
+# The package's main job: a simulated kidnapped-robot relocalization.
+# Launches fdml_simulator + fdml_localizer (launch/simulation.launch, scenario config/scenarios/demo.yaml)
+# with its own ROS master on a private port, kidnaps the robot KIDNAPS times, calls ~relocalize
+# after each and prints truth, best candidate, error, candidates and solve time, then a summary.
+#   RVIZ=1      also open rviz (needs a display; under no display use: xvfb-run -a make demo RVIZ=1)
+#   KIDNAPS=N   number of kidnaps (default 5)
+#   SCENARIO=.. MAP=..   another scenario in config/scenarios/ and the map it uses
 set -euo pipefail
 source "$(dirname "$0")/common.sh"
-"$WS/devel/lib/fdml_localization/fdml_demo_core" "$REPO_DIR/maps/office.poly" 7
+source_workspace
+
+RVIZ="${RVIZ:-0}"
+KIDNAPS="${KIDNAPS:-5}"
+SCENARIO="${SCENARIO:-demo}"
+MAP="${MAP:-apartment}"
+PORT="${FDML_DEMO_PORT:-11391}"
+export ROS_MASTER_URI="http://localhost:$PORT"
+export ROS_IP=127.0.0.1
+
+rviz_arg=false
+if [ "$RVIZ" = "1" ]; then
+  if [ -z "${DISPLAY:-}" ]; then
+    echo "demo: RVIZ=1 needs a display; run 'xvfb-run -a make demo RVIZ=1' for a virtual one" >&2
+    exit 2
+  fi
+  rviz_arg=true
+fi
+
+log="$WS/demo_launch.log"
+echo "demo: launching the simulation (scenario $SCENARIO, map $MAP, rviz $rviz_arg); log: $log"
+roslaunch -p "$PORT" fdml_localization simulation.launch rviz:="$rviz_arg" \
+  scenario:="$SCENARIO" map:="$MAP" >"$log" 2>&1 &
+launch_pid=$!
+stop_launch() {
+  kill -INT "$launch_pid" 2>/dev/null || true
+  wait "$launch_pid" 2>/dev/null || true
+}
+trap stop_launch EXIT
+
+# Wait for the master roslaunch starts (up to 30 s) before the client registers with it.
+for _ in $(seq 300); do
+  rosnode list >/dev/null 2>&1 && break
+  sleep 0.1
+done
+
+status=0
+/usr/bin/python3 "$REPO_DIR/scripts/demo_client.py" --kidnaps "$KIDNAPS" || status=$?
+if [ "$status" -eq 2 ]; then
+  echo "demo: the nodes did not come up; the end of $log:" >&2
+  tail -n 30 "$log" >&2
+fi
+if [ "$rviz_arg" = true ] && [ "$status" -ne 2 ] && [ -t 0 ]; then
+  read -r -p "demo: rviz stays open; press Enter to quit. " _ || true
+fi
+exit "$status"

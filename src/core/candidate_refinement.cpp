@@ -154,7 +154,9 @@ Candidate refineSeed(const MapRayCaster& map, const Pose2& seed, const std::vect
     }
     return use;
   };
-  auto countUsed = [](const std::vector<bool>& use) { return static_cast<int>(std::count(use.begin(), use.end(), true)); };
+  auto countUsed = [](const std::vector<bool>& use) {
+    return static_cast<int>(std::count(use.begin(), use.end(), true));
+  };
   // Re-polishes on the current inliers while that improves the consensus.
   auto polishRounds = [&]() {
     for (int round = 0; round < settings.max_rounds; ++round)

@@ -23,16 +23,27 @@ struct ResidualRow
   bool valid = false;
 };
 
-ResidualRow residualRow(const MapRayCaster& map, const Pose2& q, const Reading& reading)
+/// cos and sin of the robot's heading and of a reading's mounting angle.
+struct Rotation
+{
+  double c = 1.0;
+  double s = 0.0;
+  explicit Rotation(double angle) : c(std::cos(angle)), s(std::sin(angle)) {}
+};
+
+ResidualRow residualRow(const MapRayCaster& map, const Pose2& q, const Rotation& rq, const Reading& reading,
+                        const Rotation& rg)
 {
   ResidualRow row;
-  const Pose2 sensor = compose(q, reading.offset);
-  const Vec2 origin = sensor.position();
+  const double c = rq.c;
+  const double s = rq.s;
+  const Vec2 origin(q.x + c * reading.offset.x - s * reading.offset.y,
+                    q.y + s * reading.offset.x + c * reading.offset.y);
   if (!map.isFree(origin))
   {
     return row;
   }
-  const Vec2 u = sensor.heading();
+  const Vec2 u(c * rg.c - s * rg.s, s * rg.c + c * rg.s);
   const RayHit hit = map.cast(origin, u);
   if (!hit.hit() || !std::isfinite(hit.distance))
   {
@@ -54,8 +65,6 @@ ResidualRow residualRow(const MapRayCaster& map, const Pose2& q, const Reading& 
     return row;
   }
   // t = (c - n.p) / (n.u): dt/dp = -n / (n.u), dt/dphi = -t (n.u_perp) / (n.u).
-  const double c = std::cos(q.theta);
-  const double s = std::sin(q.theta);
   const Vec2 dp_dtheta(-s * reading.offset.x - c * reading.offset.y, c * reading.offset.x - s * reading.offset.y);
   const Vec2 u_perp(-u.y(), u.x());
   row.jacobian(0) = -n.x() / nu;
@@ -75,16 +84,17 @@ struct System
 };
 
 System buildSystem(const MapRayCaster& map, const Pose2& q, const std::vector<Reading>& readings,
-                   const std::vector<bool>& use, double scale)
+                   const std::vector<Rotation>& mounts, const std::vector<bool>& use, double scale)
 {
   System sys;
+  const Rotation rq(q.theta);
   for (std::size_t i = 0; i < readings.size(); ++i)
   {
     if (!use[i] || !std::isfinite(readings[i].range))
     {
       continue;
     }
-    const ResidualRow row = residualRow(map, q, readings[i]);
+    const ResidualRow row = residualRow(map, q, rq, readings[i], mounts[i]);
     ++sys.used;
     if (!row.valid)
     {
@@ -123,7 +133,13 @@ PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std:
 {
   PolishOutcome out;
   out.pose = start;
-  System sys = buildSystem(map, out.pose, readings, use, robust_scale);
+  std::vector<Rotation> mounts;
+  mounts.reserve(readings.size());
+  for (const Reading& r : readings)
+  {
+    mounts.emplace_back(r.offset.theta);
+  }
+  System sys = buildSystem(map, out.pose, readings, mounts, use, robust_scale);
   double lambda = 1e-3;
   for (int iter = 0; iter < max_iterations; ++iter)
   {
@@ -142,7 +158,7 @@ PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std:
     const double scale = std::max({ 1.0, shift / max_shift, std::abs(delta(2)) / max_turn });
     delta /= scale;
     const Pose2 trial = step(out.pose, delta);
-    const System next = buildSystem(map, trial, readings, use, robust_scale);
+    const System next = buildSystem(map, trial, readings, mounts, use, robust_scale);
     if (next.cost < sys.cost)
     {
       out.pose = trial;
@@ -162,7 +178,7 @@ PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std:
       }
     }
   }
-  const System final_sys = buildSystem(map, out.pose, readings, use, 0.0);
+  const System final_sys = buildSystem(map, out.pose, readings, mounts, use, 0.0);
   const int dof = final_sys.used - 3;
   double sigma2 = noise_sigma * noise_sigma;
   if (dof > 0)

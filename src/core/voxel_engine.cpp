@@ -26,6 +26,11 @@ double secondsSince(std::chrono::steady_clock::time_point start)
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+/// Where rays hit near a concave corner, h is the minimum of two linear pieces and peaks between
+/// samples, above all of them, by up to about the slope difference times half a cell: the band
+/// [d - tau, d + tau] is widened by this many cells so the truth's voxel stays in its preimage.
+constexpr double kKinkMargin = 0.5;
+
 int floorDiv(double value)
 {
   return static_cast<int>(std::floor(value));
@@ -51,7 +56,8 @@ void markRow(const float* rmin, const float* rmax, int begin, int end, float lo,
   const __m128 vhi = _mm_set1_ps(no_return ? std::numeric_limits<float>::infinity() : hi);
   for (; ix + 4 <= end; ix += 4)
   {
-    const __m128 in = _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(rmin + ix), vhi), _mm_cmpge_ps(_mm_loadu_ps(rmax + ix), vlo));
+    const __m128 below = _mm_cmple_ps(_mm_loadu_ps(rmin + ix), vhi);
+    const __m128 in = _mm_and_ps(below, _mm_cmpge_ps(_mm_loadu_ps(rmax + ix), vlo));
     row[ix >> 6] |= static_cast<std::uint64_t>(_mm_movemask_ps(in)) << (ix & 63);
   }
 #endif
@@ -120,9 +126,9 @@ void VoxelEngine::fillPreimageSlice(const Reading& reading, int it, VoxelSet& se
   const int ny = spec_.ny;
   const int nt = spec_.nt;
   const bool no_return = !std::isfinite(reading.range);
-  const float lo = static_cast<float>(no_return ? reading.max_range - options_.range_tolerance
-                                                : reading.range - options_.range_tolerance);
-  const float hi = static_cast<float>(reading.range + options_.range_tolerance);
+  const double band = preimageBand();
+  const float lo = static_cast<float>(no_return ? reading.max_range - band : reading.range - band);
+  const float hi = static_cast<float>(reading.range + band);
   const std::size_t slice = static_cast<std::size_t>(nx) * ny;
   const double theta = spec_.centreTheta(it);
   const double c = std::cos(theta);
@@ -150,6 +156,11 @@ void VoxelEngine::fillPreimageSlice(const Reading& reading, int it, VoxelSet& se
     const std::size_t base = static_cast<std::size_t>(t0) * slice + static_cast<std::size_t>(iy + sy) * nx + sx;
     markRow(bmin + base, bmax + base, x_begin, x_end, lo, hi, no_return, set.row(iy, it));
   }
+}
+
+double VoxelEngine::preimageBand() const
+{
+  return options_.range_tolerance + kKinkMargin * spec_.cell;
 }
 
 VoxelSet VoxelEngine::rawPreimage(const Reading& reading)

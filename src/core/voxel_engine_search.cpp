@@ -202,9 +202,9 @@ void VoxelEngine::localizeRobust(const std::vector<Reading>& readings, Result& r
           strong.push_back(s.candidate);
         }
       }
-      if (static_cast<int>(rankAndDeduplicate(std::move(strong), options_.uniqueness_distance, options_.uniqueness_angle,
-                                              options_.max_candidates)
-                               .size()) >= options_.max_candidates)
+      const std::vector<Candidate> ranked = rankAndDeduplicate(
+          std::move(strong), options_.uniqueness_distance, options_.uniqueness_angle, options_.max_candidates);
+      if (static_cast<int>(ranked.size()) >= options_.max_candidates)
       {
         break;
       }

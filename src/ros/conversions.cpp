@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <stdexcept>
 
 namespace fdml_localization
@@ -33,7 +35,8 @@ geometry_msgs::Quaternion yawToQuaternion(double yaw)
 double quaternionToYaw(const geometry_msgs::Quaternion& q)
 {
   const double siny = 2.0 * (q.w * q.z + q.x * q.y);
-  const double cosy = 1.0 - 2.0 * (q.y * q.y + q.z * q.z);
+  // Homogeneous form: also right for a quaternion that is not normalised.
+  const double cosy = q.w * q.w + q.x * q.x - q.y * q.y - q.z * q.z;
   if (!std::isfinite(siny) || !std::isfinite(cosy) || (siny == 0.0 && cosy == 0.0))
   {
     return 0.0;
@@ -203,6 +206,285 @@ nav_msgs::OccupancyGrid toOccupancyGrid(const core::MapRayCaster& caster, double
     }
   }
   return grid;
+}
+
+core::OccupancyGrid fromOccupancyGridMsg(const nav_msgs::OccupancyGrid& msg)
+{
+  core::OccupancyGrid grid;
+  grid.width = static_cast<int>(std::min<std::uint32_t>(msg.info.width, std::numeric_limits<int>::max()));
+  grid.height = static_cast<int>(std::min<std::uint32_t>(msg.info.height, std::numeric_limits<int>::max()));
+  grid.resolution = msg.info.resolution;
+  grid.origin = core::Pose2(msg.info.origin.position.x, msg.info.origin.position.y,
+                            quaternionToYaw(msg.info.origin.orientation));
+  grid.cells.assign(msg.data.begin(), msg.data.end());
+  return grid;
+}
+
+nav_msgs::OccupancyGrid toOccupancyGridMsg(const core::OccupancyGrid& grid, const std::string& frame,
+                                           const ros::Time& stamp)
+{
+  nav_msgs::OccupancyGrid msg;
+  msg.header.frame_id = frame;
+  msg.header.stamp = stamp;
+  msg.info.map_load_time = stamp;
+  msg.info.resolution = static_cast<float>(grid.resolution);
+  msg.info.width = static_cast<std::uint32_t>(std::max(grid.width, 0));
+  msg.info.height = static_cast<std::uint32_t>(std::max(grid.height, 0));
+  msg.info.origin = toPoseMsg(grid.origin);
+  msg.data.assign(grid.cells.begin(), grid.cells.end());
+  return msg;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Localizer node conversions (issue 6): covariance, readings, results, sensor input, rays.
+// ---------------------------------------------------------------------------------------------
+
+boost::array<double, 36> toCovariance6(const Eigen::Matrix3d& covariance)
+{
+  boost::array<double, 36> out;
+  out.fill(0.0);
+  const int index[3] = { 0, 1, 5 };
+  for (int r = 0; r < 3; ++r)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      out[static_cast<std::size_t>(index[r] * 6 + index[c])] = covariance(r, c);
+    }
+  }
+  return out;
+}
+
+Eigen::Matrix3d fromCovariance6(const boost::array<double, 36>& covariance)
+{
+  Eigen::Matrix3d out;
+  const int index[3] = { 0, 1, 5 };
+  for (int r = 0; r < 3; ++r)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      out(r, c) = covariance[static_cast<std::size_t>(index[r] * 6 + index[c])];
+    }
+  }
+  return out;
+}
+
+fdml_localization::Reading toReadingMsg(const core::Reading& reading)
+{
+  fdml_localization::Reading msg;
+  msg.sensor_offset = toPose2D(reading.offset);
+  msg.range = reading.range;
+  msg.max_range = reading.max_range;
+  return msg;
+}
+
+core::Reading fromReadingMsg(const fdml_localization::Reading& msg)
+{
+  core::Reading reading;
+  reading.offset = fromPose2D(msg.sensor_offset);
+  reading.range = msg.range;
+  reading.max_range = msg.max_range;
+  return reading;
+}
+
+std::vector<core::Reading> fromReadingMsgs(const std::vector<fdml_localization::Reading>& readings)
+{
+  std::vector<core::Reading> out;
+  out.reserve(readings.size());
+  for (const auto& msg : readings)
+  {
+    out.push_back(fromReadingMsg(msg));
+  }
+  return out;
+}
+
+fdml_localization::Candidate toCandidateMsg(const core::Candidate& candidate)
+{
+  fdml_localization::Candidate msg;
+  msg.pose = toPoseMsg(candidate.pose);
+  msg.inliers = static_cast<std::uint32_t>(std::max(0, candidate.inliers));
+  msg.inlier_mask.assign(candidate.inlier_mask.begin(), candidate.inlier_mask.end());
+  msg.rms_residual = candidate.rms_residual;
+  return msg;
+}
+
+fdml_localization::LocalizationResult toResultMsg(const core::Result& result)
+{
+  fdml_localization::LocalizationResult msg;
+  for (const auto& candidate : result.candidates)
+  {
+    msg.candidates.push_back(toCandidateMsg(candidate));
+  }
+  msg.readings_used = static_cast<std::uint32_t>(std::max(0, result.readings_used));
+  msg.min_inliers_used = static_cast<std::uint32_t>(std::max(0, result.min_inliers_used));
+  msg.engine = core::toString(result.engine);
+  msg.method = core::toString(result.method);
+  msg.solve_time = result.times.total;
+  const std::pair<const char*, double> stages[] = {
+    { "table", result.times.table },           { "preimages", result.times.preimages },
+    { "count", result.times.count },           { "components", result.times.components },
+    { "verification", result.times.verification }, { "polish", result.times.polish },
+  };
+  for (const auto& stage : stages)
+  {
+    msg.stage_names.push_back(stage.first);
+    msg.stage_times.push_back(stage.second);
+  }
+  msg.search_truncated = result.truncated;
+  return msg;
+}
+
+void setDropCounts(const std::map<std::string, std::uint64_t>& drops, fdml_localization::LocalizationResult* msg)
+{
+  msg->drop_reasons.clear();
+  msg->drop_counts.clear();
+  for (const auto& entry : drops)
+  {
+    msg->drop_reasons.push_back(entry.first);
+    msg->drop_counts.push_back(static_cast<std::uint32_t>(std::min<std::uint64_t>(entry.second, 0xffffffffu)));
+  }
+}
+
+namespace
+{
+/// REP-117 check of one range value; returns nullptr when usable (+inf included).
+const char* rangeProblem(double range, double min_range, double max_range)
+{
+  if (std::isnan(min_range) || std::isnan(max_range) || !(max_range > 0.0) || max_range < min_range)
+  {
+    return drop_reason::kInvalidLimits;
+  }
+  if (std::isnan(range))
+  {
+    return drop_reason::kNanRange;
+  }
+  if (range == -core::kInf)
+  {
+    return drop_reason::kNegativeInfinity;
+  }
+  if (range == core::kInf)
+  {
+    return nullptr;
+  }
+  if (range < 0.0)
+  {
+    return drop_reason::kNegativeRange;
+  }
+  if (range < min_range)
+  {
+    return drop_reason::kBelowMinRange;
+  }
+  if (range > max_range)
+  {
+    return drop_reason::kAboveMaxRange;
+  }
+  return nullptr;
+}
+}  // namespace
+
+bool rangeToReading(const sensor_msgs::Range& msg, double received, TimedReading* reading, std::string* reason)
+{
+  const char* problem = rangeProblem(msg.range, msg.min_range, msg.max_range);
+  if (problem)
+  {
+    *reason = problem;
+    return false;
+  }
+  reading->frame_id = msg.header.frame_id;
+  reading->stamp = static_cast<std::int64_t>(msg.header.stamp.toNSec());
+  reading->beam = core::Pose2();
+  reading->range = msg.range;
+  reading->max_range = msg.max_range;
+  reading->received = received;
+  return true;
+}
+
+std::vector<TimedReading> scanToReadings(const sensor_msgs::LaserScan& msg, int beams, double received,
+                                         std::map<std::string, std::uint64_t>* drops)
+{
+  std::vector<std::size_t> usable;
+  for (std::size_t i = 0; i < msg.ranges.size(); ++i)
+  {
+    const char* problem = rangeProblem(msg.ranges[i], msg.range_min, msg.range_max);
+    if (problem)
+    {
+      ++(*drops)[problem];
+      continue;
+    }
+    usable.push_back(i);
+  }
+  std::vector<TimedReading> out;
+  if (usable.empty() || beams <= 0)
+  {
+    return out;
+  }
+  const std::size_t n = std::min(usable.size(), static_cast<std::size_t>(beams));
+  for (std::size_t j = 0; j < n; ++j)
+  {
+    const std::size_t i = usable[j * usable.size() / n];
+    TimedReading reading;
+    reading.frame_id = msg.header.frame_id;
+    reading.stamp = static_cast<std::int64_t>(msg.header.stamp.toNSec()) +
+                    std::llround(static_cast<double>(i) * msg.time_increment * 1e9);
+    reading.beam = core::Pose2(0.0, 0.0, core::wrapAngle(msg.angle_min + static_cast<double>(i) * msg.angle_increment));
+    reading.range = msg.ranges[i];
+    reading.max_range = msg.range_max;
+    reading.received = received;
+    out.push_back(reading);
+  }
+  return out;
+}
+
+visualization_msgs::MarkerArray readingMarkers(const std::vector<core::Reading>& readings, const core::Pose2& pose,
+                                               const std::vector<bool>& inlier_mask, const std::string& frame_id,
+                                               const ros::Time& stamp, double no_return_length)
+{
+  visualization_msgs::MarkerArray array;
+  visualization_msgs::Marker clear;
+  clear.header.frame_id = frame_id;
+  clear.header.stamp = stamp;
+  clear.action = visualization_msgs::Marker::DELETEALL;
+  array.markers.push_back(clear);
+
+  visualization_msgs::Marker rays;
+  rays.header = clear.header;
+  rays.ns = "rays";
+  rays.id = 0;
+  rays.type = visualization_msgs::Marker::LINE_LIST;
+  rays.action = visualization_msgs::Marker::ADD;
+  rays.pose.orientation.w = 1.0;
+  rays.scale.x = 0.02;
+  visualization_msgs::Marker hits = rays;
+  hits.ns = "hits";
+  hits.id = 1;
+  hits.type = visualization_msgs::Marker::SPHERE_LIST;
+  hits.scale.x = hits.scale.y = hits.scale.z = 0.06;
+
+  for (std::size_t i = 0; i < readings.size(); ++i)
+  {
+    const core::Pose2 sensor = core::compose(pose, readings[i].offset);
+    const bool no_return = !std::isfinite(readings[i].range);
+    const double length =
+        no_return ? std::min(no_return_length, std::isfinite(readings[i].max_range) ? readings[i].max_range : no_return_length)
+                  : readings[i].range;
+    const core::Vec2 end = sensor.position() + length * sensor.heading();
+    const bool inlier = i >= inlier_mask.size() || inlier_mask[i];
+    const std_msgs::ColorRGBA c =
+        no_return ? makeColor(0.6f, 0.6f, 0.6f) : (inlier ? makeColor(0.1f, 0.8f, 0.1f) : makeColor(0.9f, 0.1f, 0.1f));
+    rays.points.push_back(toPointMsg(sensor.position()));
+    rays.points.push_back(toPointMsg(end));
+    rays.colors.push_back(c);
+    rays.colors.push_back(c);
+    if (!no_return)
+    {
+      hits.points.push_back(toPointMsg(end));
+      hits.colors.push_back(c);
+    }
+  }
+  rays.color = makeColor(1.0f, 1.0f, 1.0f);
+  hits.color = rays.color;
+  array.markers.push_back(rays);
+  array.markers.push_back(hits);
+  return array;
 }
 
 }  // namespace fdml_localization

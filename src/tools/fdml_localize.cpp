@@ -10,6 +10,7 @@
 // and one candidate per line, best first; exit 0 (also with no candidate), 2 on bad input.
 #include "fdml_localization/core/localizer.h"
 #include "fdml_localization/core/map_io.h"
+#include "fdml_localization/core/text_parsing.h"
 
 #include <cerrno>
 #include <cmath>
@@ -49,31 +50,7 @@ std::string trim(const std::string& s)
   return s.substr(begin, end - begin + 1);
 }
 
-double parseDouble(const std::string& text, const std::string& what)
-{
-  const std::string t = trim(text);
-  char* end = nullptr;
-  errno = 0;
-  const double value = std::strtod(t.c_str(), &end);
-  if (t.empty() || end != t.c_str() + t.size())
-  {
-    throw UsageError(what + ": '" + text + "' is not a number");
-  }
-  return value;
-}
 
-int parseInt(const std::string& text, const std::string& what)
-{
-  const std::string t = trim(text);
-  char* end = nullptr;
-  errno = 0;
-  const long value = std::strtol(t.c_str(), &end, 10);
-  if (t.empty() || end != t.c_str() + t.size() || errno == ERANGE || value < -1000000000L || value > 1000000000L)
-  {
-    throw UsageError(what + ": '" + text + "' is not an integer");
-  }
-  return static_cast<int>(value);
-}
 
 std::vector<std::string> splitCsv(const std::string& line)
 {
@@ -138,11 +115,11 @@ std::vector<core::Reading> readCsv(const std::string& path, double default_max_r
                        std::to_string(fields.size()));
     }
     core::Reading r;
-    r.offset.x = parseDouble(fields[0], where + ": gx");
-    r.offset.y = parseDouble(fields[1], where + ": gy");
-    r.offset.theta = parseDouble(fields[2], where + ": gtheta");
-    r.range = parseDouble(fields[3], where + ": d");
-    r.max_range = has_max_range ? parseDouble(fields[4], where + ": max_range") : default_max_range;
+    r.offset.x = core::parseNumber(fields[0], where + ": gx", true);
+    r.offset.y = core::parseNumber(fields[1], where + ": gy", true);
+    r.offset.theta = core::parseNumber(fields[2], where + ": gtheta", true);
+    r.range = core::parseNumber(fields[3], where + ": d", true);
+    r.max_range = has_max_range ? core::parseNumber(fields[4], where + ": max_range", true) : default_max_range;
     if (!std::isfinite(r.offset.x) || !std::isfinite(r.offset.y) || !std::isfinite(r.offset.theta))
     {
       throw UsageError(where + ": gx, gy and gtheta must be finite");
@@ -192,16 +169,16 @@ Arguments parseArguments(int argc, char** argv)
     }
     else if (flag == "--resolution")
     {
-      args.options.resolution = parseInt(value(), flag);
+      args.options.resolution = core::parseInteger(value(), flag);
     }
     else if (flag == "--theta-resolution")
     {
-      args.options.theta_resolution = parseInt(value(), flag);
+      args.options.theta_resolution = core::parseInteger(value(), flag);
     }
     else if (flag == "--min-inliers")
     {
       const std::string v = value();
-      args.options.min_inliers = v == "auto" ? 0 : parseInt(v, flag);
+      args.options.min_inliers = v == "auto" ? 0 : core::parseInteger(v, flag);
       if (v != "auto" && args.options.min_inliers < 3)
       {
         throw UsageError("--min-inliers " + v + ": must be 'auto' or an integer >= 3");
@@ -217,15 +194,15 @@ Arguments parseArguments(int argc, char** argv)
     }
     else if (flag == "--range-tolerance")
     {
-      args.options.range_tolerance = parseDouble(value(), flag);
+      args.options.range_tolerance = core::parseNumber(value(), flag);
     }
     else if (flag == "--tolerance")
     {
-      args.options.agreement_tolerance = parseDouble(value(), flag);
+      args.options.agreement_tolerance = core::parseNumber(value(), flag);
     }
     else if (flag == "--threads")
     {
-      args.options.threads = parseInt(value(), flag);
+      args.options.threads = core::parseInteger(value(), flag);
     }
     else if (flag == "--cache-dir")
     {
@@ -233,11 +210,11 @@ Arguments parseArguments(int argc, char** argv)
     }
     else if (flag == "--max-candidates")
     {
-      args.options.max_candidates = parseInt(value(), flag);
+      args.options.max_candidates = core::parseInteger(value(), flag);
     }
     else if (flag == "--max-range")
     {
-      args.max_range = parseDouble(value(), flag);
+      args.max_range = core::parseNumber(value(), flag, true);
     }
     else if (flag == "--verbose")
     {

@@ -149,7 +149,7 @@ TEST(DistanceTable, SamplesAndBlocksMatchBruteForce)
 }
 
 /// Brute-force preimage: the 8 samples around (centre (+) g), straight from the table.
-bool bruteForceInPreimage(const DistanceTable& table, const Pose2& centre, const Reading& r, double tau)
+bool bruteForceInPreimage(const DistanceTable& table, const Pose2& centre, const Reading& r, double band)
 {
   const GridSpec& spec = table.spec();
   const Pose2 p = compose(centre, r.offset);
@@ -178,12 +178,12 @@ bool bruteForceInPreimage(const DistanceTable& table, const Pose2& centre, const
         }
         if (std::isinf(r.range))
         {
-          above = above || h >= static_cast<float>(r.max_range - tau);
+          above = above || h >= static_cast<float>(r.max_range - band);
           below = true;
           continue;
         }
-        below = below || h <= static_cast<float>(r.range + tau);
-        above = above || h >= static_cast<float>(r.range - tau);
+        below = below || h <= static_cast<float>(r.range + band);
+        above = above || h >= static_cast<float>(r.range - band);
       }
     }
   }
@@ -197,6 +197,7 @@ TEST(VoxelEngine, RawPreimageIsTheSignChangeTest)
   options.resolution = 24;
   VoxelEngine engine(map, options);
   const GridSpec& spec = engine.grid();
+  EXPECT_DOUBLE_EQ(engine.preimageBand(), options.range_tolerance + 0.5 * spec.cell);
   std::vector<Reading> readings(3);
   readings[0].offset = Pose2(0.0, 0.0, 0.0);
   readings[0].range = 2.0;
@@ -216,7 +217,7 @@ TEST(VoxelEngine, RawPreimageIsTheSignChangeTest)
       int iy = 0;
       int it = 0;
       spec.unindex(v, ix, iy, it);
-      const bool expected = bruteForceInPreimage(engine.table(), spec.centre(v), r, options.range_tolerance);
+      const bool expected = bruteForceInPreimage(engine.table(), spec.centre(v), r, engine.preimageBand());
       mismatches += expected != set.test(ix, iy, it) ? 1 : 0;
       members += expected ? 1 : 0;
     }
@@ -477,12 +478,13 @@ TEST(LocalizerInput, BadInputIsAClearError)
   LocalizerOptions paper = options;
   paper.method = Method::Paper;
   EXPECT_THROW(Localizer(map, paper), std::invalid_argument);
-  // The adaptive engine allows resolutions above the voxel engine's limit.
+  // The resolution's range depends on the engine: the adaptive engine goes far finer.
   LocalizerOptions adaptive = options;
   adaptive.engine = Engine::Adaptive;
-  adaptive.resolution = 2000;
+  EXPECT_NO_THROW(Localizer(map, adaptive));
+  adaptive.resolution = 5000;  // fine for the adaptive engine, too many voxels for the voxel one
   EXPECT_TRUE(validate(adaptive).empty());
-  adaptive.resolution = kMaxAdaptiveResolution + 1;
+  adaptive.resolution = 200000;
   EXPECT_EQ(validate(adaptive).size(), 1u);
   EXPECT_THROW(Localizer(std::make_shared<const MapRayCaster>(), options), std::invalid_argument);
   EXPECT_TRUE(validate(LocalizerOptions()).empty());

@@ -79,12 +79,18 @@ struct RefinementSettings
 };
 
 /**
- * @brief From a seed pose and a hypothesis of which readings it explains: a robust polish on
- *        the hypothesis (leaving out the readings whose rays pass so close to a map vertex that
- *        the seed's error could put them on the other side of an occlusion edge), then rounds of verification and plain polish on the eps-inliers while the
- *        consensus improves (more inliers, then lower RMS), and leave-one-out re-polishes (the
- *        worst readings) to escape the false minima that corners of the map create in the
- *        piecewise-smooth cost. Never returns a pose worse than the seed.
+ * @brief From a seed pose and a hypothesis of which readings it explains, the best pose found:
+ *        1. annealed robust polishes (Cauchy scale shrinking to eps) on the hypothesis, on the
+ *           hypothesis without the readings whose rays pass so close to a map vertex that the
+ *           seed's error could put them across an occlusion edge, and, while fewer than
+ *           target_inliers readings agree, without the 1, 2, 3 readings most shortened at the
+ *           seed (unknown obstacles only shorten readings);
+ *        2. optionally a lattice search around the seed (local_search_cells);
+ *        3. rounds of verification and plain polish on the eps-inliers while the consensus
+ *           improves (more inliers, then lower RMS);
+ *        4. leave-one-out re-polishes (the worst reading, the ones passing nearest a vertex) to
+ *           escape the false minima that corners create in the piecewise-smooth cost.
+ *        Never returns a pose worse than the seed.
  */
 Candidate refineSeed(const MapRayCaster& map, const Pose2& seed, const std::vector<Reading>& readings,
                      const std::vector<bool>& hypothesis, const RefinementSettings& settings);

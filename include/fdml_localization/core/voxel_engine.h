@@ -20,6 +20,18 @@ namespace fdml_localization
 {
 namespace core
 {
+/**
+ * @brief The voxel engine. Per call: (1) the preimage of each reading by the sign-change test
+ *        on the distance table's 2 x 2 x 2 sample blocks, then a one-voxel dilation (bit-packed
+ *        sets); (2) the count field (uint8 per voxel), M_k' = {count >= k'}; (3) seeds.
+ *        Robust method: the regional maxima (peak plateaus) of the count field of the dilated
+ *        preimages and of the raw ones, level by level from k down, each refined by
+ *        refineSeed() (exact ray casts, robust polish); in automatic mode the first level where
+ *        a seed explains that many readings is k'; supports are the sizes of the seeds'
+ *        components of M_k'. Paper and baseline methods: the circular-mean centres of the
+ *        components of M_k' (26-neighbour, periodic theta), the eps filter, delta uniqueness.
+ *        Ranking and duplicate removal: rankAndDeduplicate().
+ */
 class VoxelEngine : public LocalizerEngine
 {
 public:
@@ -39,9 +51,17 @@ public:
   const std::string& cacheMessage() const { return cache_message_; }
 
   /**
+   * @brief Half-width b of the band [d - b, d + b] the preimages test [m]: the range tolerance
+   *        tau plus half a cell, because where a ray hits near a concave corner h peaks between
+   *        samples, above all of them, by up to about half a cell times the slope difference.
+   */
+  double preimageBand() const;
+
+  /**
    * @brief The voxel preimage of one reading before dilation: voxel v is in it when the
-   *        samples of h around (centre of v) (+) g take values on both sides of [d - tau, d + tau]
-   *        or inside it (for d = +inf: some sample exceeds max_range - tau). Prepares on first use.
+   *        samples of h around (centre of v) (+) g take values on both sides of [d - b, d + b]
+   *        or inside it (for d = +inf: some sample exceeds max_range - b), b = preimageBand().
+   *        Prepares on first use.
    */
   VoxelSet rawPreimage(const Reading& reading);
   /// The dilated preimages of a batch, one per reading.

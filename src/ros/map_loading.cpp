@@ -1,0 +1,100 @@
+#include "fdml_localization/ros/map_loading.h"
+
+#include "fdml_localization/ros/param_utils.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+namespace fdml_localization
+{
+namespace
+{
+bool isYamlPath(const std::string& path)
+{
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext == ".yaml" || ext == ".yml";
+}
+}  // namespace
+
+std::string resolveMapPath(const std::string& location)
+{
+  std::string error;
+  const std::string path = resolveResourcePath(location, &error);
+  if (!error.empty())
+  {
+    throw MapLoadError("~map_file \"" + location + "\": " + error);
+  }
+  return path;
+}
+
+std::string describeConversion(const core::OccupancyGrid& grid, const core::GridConversionReport& report)
+{
+  char text[512];
+  std::snprintf(text, sizeof(text),
+                "%d x %d cells at %g m; %d free region(s), kept %ld of %ld free cells; holes: %d found, %d under "
+                "%g m^2 dropped as specks, %d kept; rings: %d; vertices: %ld traced, %ld kept (tolerance %g m, %d "
+                "ring(s) tightened)",
+                grid.width, grid.height, grid.resolution, report.regions, report.region_cells, report.free_cells,
+                report.holes_found, report.holes_dropped, report.min_area_used,
+                report.holes_found - report.holes_dropped, 1 + report.holes_found - report.holes_dropped,
+                report.vertices_traced, report.vertices_kept, report.tolerance_used, report.rings_tightened);
+  return text;
+}
+
+LoadedMap mapFromGrid(const core::OccupancyGrid& grid, const core::GridConversionOptions& options,
+                      const std::string& source)
+{
+  LoadedMap loaded;
+  loaded.source = source;
+  loaded.grid_resolution = grid.resolution;
+  try
+  {
+    core::GridConversionReport report;
+    loaded.map = std::make_shared<const core::MapRayCaster>(core::gridToPolygon(grid, options, source, &report));
+    loaded.summary = describeConversion(grid, report);
+  }
+  catch (const std::exception& error)
+  {
+    throw MapLoadError(error.what());
+  }
+  return loaded;
+}
+
+LoadedMap loadMapFromFile(const std::string& location, const core::GridConversionOptions& options)
+{
+  const std::string path = resolveMapPath(location);
+  if (!std::ifstream(path).good())
+  {
+    throw MapLoadError("~map_file \"" + location + "\": cannot open \"" + path + "\" (missing or unreadable)");
+  }
+  try
+  {
+    if (isYamlPath(path))
+    {
+      // The grid's resolution is needed for the tolerances (withGridTolerances()): load it here,
+      // then convert as core::loadMapFile() does.
+      LoadedMap loaded = mapFromGrid(core::loadOccupancyGridYaml(path), options, path);
+      loaded.summary = path + ": " + loaded.summary;
+      return loaded;
+    }
+    LoadedMap loaded;
+    loaded.source = path;
+    loaded.map = std::make_shared<const core::MapRayCaster>(core::loadMapFile(path, options));
+    return loaded;
+  }
+  catch (const std::exception& error)
+  {
+    throw MapLoadError(std::string("~map_file: ") + error.what());
+  }
+}
+
+std::shared_ptr<const core::MapRayCaster> loadMap(const std::string& location)
+{
+  return loadMapFromFile(location).map;
+}
+
+}  // namespace fdml_localization

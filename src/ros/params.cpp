@@ -1,0 +1,320 @@
+#include "fdml_localization/ros/params.h"
+
+#include <ros/node_handle.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
+namespace fdml_localization
+{
+namespace
+{
+std::string quoted(const std::string& text)
+{
+  return "\"" + text + "\"";
+}
+
+/// Appends "~name = value is out of range; allowed: range" when @p ok is false.
+template <typename T>
+void check(std::vector<std::string>* errors, bool ok, const char* name, const T& value, const std::string& allowed)
+{
+  if (ok)
+  {
+    return;
+  }
+  std::ostringstream out;
+  out << "~" << name << " = " << value << " is out of range; allowed: " << allowed;
+  errors->push_back(out.str());
+}
+
+bool finiteIn(double value, double lo, double hi)
+{
+  return std::isfinite(value) && value >= lo && value <= hi;
+}
+
+bool validFrame(const std::string& frame)
+{
+  return !frame.empty() && frame.find_first_of(" \t\n") == std::string::npos;
+}
+}  // namespace
+
+bool parseSolveMode(const std::string& text, SolveMode* mode)
+{
+  if (text == "on_request")
+  {
+    *mode = SolveMode::OnRequest;
+    return true;
+  }
+  if (text == "continuous")
+  {
+    *mode = SolveMode::Continuous;
+    return true;
+  }
+  return false;
+}
+
+const char* toString(SolveMode mode)
+{
+  return mode == SolveMode::Continuous ? "continuous" : "on_request";
+}
+
+std::vector<std::string> validate(const Params& p)
+{
+  std::vector<std::string> errors;
+  if (p.map_file.empty() && !p.use_map_topic)
+  {
+    errors.push_back("~map_file is required unless ~use_map_topic is true: a .poly or map_server .yaml path, "
+                     "absolute or package://fdml_localization/maps/...");
+  }
+  check(&errors, finiteIn(p.map_simplify_tolerance, 0.0, 10.0), "map_simplify_tolerance", p.map_simplify_tolerance,
+        "0 (one cell) or (0, 10] m");
+  check(&errors, !std::isnan(p.map_min_area) && p.map_min_area <= 1e6, "map_min_area", p.map_min_area,
+        "< 0 (ten cells' area) or [0, 1e6] m^2");
+  const bool seed_ok = !p.map_seed_point_malformed &&
+                       (p.map_seed_point.empty() || (p.map_seed_point.size() == 2 && std::isfinite(p.map_seed_point[0]) &&
+                                                     std::isfinite(p.map_seed_point[1])));
+  if (!seed_ok)
+  {
+    std::ostringstream out;
+    out << "~map_seed_point = [";
+    for (std::size_t i = 0; i < p.map_seed_point.size(); ++i)
+    {
+      out << (i ? ", " : "") << p.map_seed_point[i];
+    }
+    out << "] is out of range; allowed: a list [x, y] of two finite numbers [m] (or unset: the largest free region)";
+    errors.push_back(out.str());
+  }
+  check(&errors, p.map_occupied_threshold >= 1 && p.map_occupied_threshold <= 100, "map_occupied_threshold",
+        p.map_occupied_threshold, "an integer in [1, 100]");
+  const int k = p.measurements_per_batch;
+  check(&errors, k >= 3 && k <= 255, "measurements_per_batch", k, "an integer in [3, 255]");
+  check(&errors, p.batch_stride >= 1 && p.batch_stride <= std::max(k, 1), "batch_stride", p.batch_stride,
+        "an integer in [1, ~measurements_per_batch]");
+  SolveMode mode;
+  check(&errors, parseSolveMode(p.mode, &mode), "mode", quoted(p.mode), "\"on_request\" or \"continuous\"");
+  check(&errors, p.beams_per_scan >= 1 && p.beams_per_scan <= 1000, "beams_per_scan", p.beams_per_scan,
+        "an integer in [1, 1000]");
+  check(&errors, finiteIn(p.transform_tolerance, 0.0, 10.0), "transform_tolerance", p.transform_tolerance,
+        "[0, 10] s");
+  check(&errors, finiteIn(p.relocalize_timeout, 1e-3, 3600.0), "relocalize_timeout", p.relocalize_timeout,
+        "(0, 3600] s");
+  check(&errors, finiteIn(p.tf_publish_rate, 1e-3, 1000.0), "tf_publish_rate", p.tf_publish_rate,
+        "(0, 1000] Hz");
+  check(&errors, validFrame(p.global_frame_id), "global_frame_id", quoted(p.global_frame_id),
+        "a non-empty frame id without spaces");
+  check(&errors, validFrame(p.odom_frame_id), "odom_frame_id", quoted(p.odom_frame_id),
+        "a non-empty frame id without spaces");
+  check(&errors, validFrame(p.base_frame_id), "base_frame_id", quoted(p.base_frame_id),
+        "a non-empty frame id without spaces");
+  check(&errors, p.odom_frame_id != p.base_frame_id && p.odom_frame_id != p.global_frame_id, "odom_frame_id",
+        quoted(p.odom_frame_id), "a frame different from ~global_frame_id and ~base_frame_id");
+  check(&errors, !p.range_topic.empty(), "range_topic", quoted(p.range_topic), "a non-empty topic name");
+  check(&errors, !p.scan_topic.empty(), "scan_topic", quoted(p.scan_topic), "a non-empty topic name");
+
+  check(&errors, p.engine == "voxel" || p.engine == "adaptive", "engine", quoted(p.engine),
+        "\"voxel\" or \"adaptive\"");
+  check(&errors, p.method == "robust" || p.method == "paper" || p.method == "baseline", "method", quoted(p.method),
+        "\"robust\", \"paper\" or \"baseline\"");
+  // The voxel engine's table holds n x n x n_theta samples; the adaptive engine goes far finer.
+  const int max_resolution = p.engine == "adaptive" ? core::kMaxAdaptiveResolution : core::kMaxVoxelResolution;
+  const std::string range = "[16, " + std::to_string(max_resolution) + "] for ~engine " + p.engine;
+  check(&errors, p.resolution >= 16 && p.resolution <= max_resolution, "resolution", p.resolution,
+        "an integer in " + range);
+  check(&errors, p.theta_resolution == 0 || (p.theta_resolution >= 16 && p.theta_resolution <= max_resolution),
+        "theta_resolution", p.theta_resolution, "0 (= ~resolution) or an integer in " + range);
+  check(&errors, p.min_inliers == 0 || (p.min_inliers >= 3 && p.min_inliers <= k), "min_inliers", p.min_inliers,
+        "0 (automatic) or an integer in [3, ~measurements_per_batch]");
+  check(&errors, p.method != "paper" || p.min_inliers != 0, "min_inliers", p.min_inliers,
+        "a fixed k' in [3, ~measurements_per_batch] with ~method paper (automatic k' is not the paper's)");
+  check(&errors, finiteIn(p.agreement_tolerance, 0.0, 10.0) && p.agreement_tolerance > 0.0, "agreement_tolerance",
+        p.agreement_tolerance, "(0, 10] m");
+  check(&errors, finiteIn(p.uniqueness_distance, 0.0, 100.0), "uniqueness_distance", p.uniqueness_distance,
+        "[0, 100] m");
+  check(&errors, finiteIn(p.uniqueness_angle, 0.0, 3.14159265358979323846), "uniqueness_angle", p.uniqueness_angle,
+        "[0, pi] rad");
+  check(&errors, finiteIn(p.range_tolerance, 0.0, 10.0), "range_tolerance", p.range_tolerance, "[0, 10] m");
+  check(&errors, p.max_candidates >= 1 && p.max_candidates <= 10000, "max_candidates", p.max_candidates,
+        "an integer in [1, 10000]");
+  check(&errors, p.threads >= 0 && p.threads <= 1024, "threads", p.threads,
+        "0 (all cores) or an integer in [1, 1024]");
+  check(&errors, p.max_boxes >= 1000, "max_boxes", p.max_boxes, "an integer >= 1000");
+  check(&errors, finiteIn(p.deadline, 0.0, 3600.0), "deadline", p.deadline, "0 (none) or (0, 3600] s");
+  return errors;
+}
+
+core::LocalizerOptions toLocalizerOptions(const Params& p)
+{
+  core::LocalizerOptions options;
+  options.engine = p.engine == "adaptive" ? core::Engine::Adaptive : core::Engine::Voxel;
+  if (p.method == "paper")
+  {
+    options.method = core::Method::Paper;
+  }
+  else if (p.method == "baseline")
+  {
+    options.method = core::Method::Baseline;
+  }
+  else
+  {
+    options.method = core::Method::Robust;
+  }
+  options.resolution = p.resolution;
+  options.theta_resolution = p.theta_resolution;
+  options.min_inliers = p.min_inliers;
+  options.agreement_tolerance = p.agreement_tolerance;
+  options.uniqueness_distance = p.uniqueness_distance;
+  options.uniqueness_angle = p.uniqueness_angle;
+  options.range_tolerance = p.range_tolerance;
+  options.max_candidates = p.max_candidates;
+  options.threads = p.threads;
+  options.cache_dir = p.cache_dir;
+  options.max_boxes = p.max_boxes;
+  options.deadline = p.deadline;
+  return options;
+}
+
+core::GridConversionOptions toGridOptions(const Params& p)
+{
+  core::GridConversionOptions options;
+  options.tolerance = p.map_simplify_tolerance;
+  options.min_area = p.map_min_area;
+  options.use_seed = p.map_seed_point.size() == 2;
+  if (options.use_seed)
+  {
+    options.seed_point = core::Vec2(p.map_seed_point[0], p.map_seed_point[1]);
+  }
+  options.occupied_threshold = p.map_occupied_threshold;
+  return options;
+}
+
+Params withGridTolerances(const Params& params, double resolution)
+{
+  Params p = params;
+  if (!(resolution > 0.0) || !std::isfinite(resolution))
+  {
+    return p;
+  }
+  if (!p.range_tolerance_set)
+  {
+    p.range_tolerance = std::max(p.range_tolerance, resolution);
+  }
+  if (!p.agreement_tolerance_set)
+  {
+    p.agreement_tolerance = std::max(p.agreement_tolerance, 2.0 * resolution);
+  }
+  return p;
+}
+
+SolveMode solveMode(const Params& params)
+{
+  SolveMode mode = SolveMode::OnRequest;
+  parseSolveMode(params.mode, &mode);
+  return mode;
+}
+
+std::string expandUser(const std::string& path, const std::string& home)
+{
+  if (path == "~")
+  {
+    return home;
+  }
+  if (path.size() >= 2 && path[0] == '~' && path[1] == '/')
+  {
+    return home + path.substr(1);
+  }
+  return path;
+}
+
+std::string defaultCacheDir(const std::string& ros_home, const std::string& home)
+{
+  if (!ros_home.empty())
+  {
+    return ros_home + "/fdml_localization";
+  }
+  return (home.empty() ? std::string(".") : home) + "/.ros/fdml_localization";
+}
+
+std::string describe(const Params& p)
+{
+  std::ostringstream out;
+  out << "fdml_localizer configuration:\n"
+      << "  map_file: " << (p.map_file.empty() ? "(none)" : p.map_file)
+      << ", use_map_topic: " << (p.use_map_topic ? "true" : "false") << "\n"
+      << "  grid maps: map_simplify_tolerance: " << p.map_simplify_tolerance << " m (0 = one cell), map_min_area: "
+      << p.map_min_area << " m^2 (< 0 = ten cells), map_seed_point: "
+      << (p.map_seed_point.size() == 2
+              ? "[" + std::to_string(p.map_seed_point[0]) + ", " + std::to_string(p.map_seed_point[1]) + "]"
+              : std::string("(largest free region)"))
+      << ", map_occupied_threshold: " << p.map_occupied_threshold << "\n"
+      << "  measurements_per_batch: " << p.measurements_per_batch << ", batch_stride: " << p.batch_stride
+      << ", mode: " << p.mode << ", beams_per_scan: " << p.beams_per_scan << "\n"
+      << "  transform_tolerance: " << p.transform_tolerance << " s, relocalize_timeout: " << p.relocalize_timeout
+      << " s, publish_tf: " << (p.publish_tf ? "true" : "false") << " at " << p.tf_publish_rate << " Hz\n"
+      << "  frames: global " << p.global_frame_id << ", odom " << p.odom_frame_id << ", base " << p.base_frame_id
+      << "\n"
+      << "  topics: range " << p.range_topic << ", scan " << p.scan_topic << "\n"
+      << "  engine: " << p.engine << ", method: " << p.method << ", resolution: " << p.resolution
+      << ", theta_resolution: " << p.theta_resolution << ", min_inliers: " << p.min_inliers << "\n"
+      << "  agreement_tolerance: " << p.agreement_tolerance
+      << " m" << (p.agreement_tolerance_set ? "" : " (default)") << ", uniqueness_distance: " << p.uniqueness_distance
+      << " m, uniqueness_angle: " << p.uniqueness_angle << " rad, range_tolerance: " << p.range_tolerance << " m"
+      << (p.range_tolerance_set ? "" : " (default)") << "\n"
+      << "  max_candidates: " << p.max_candidates << ", threads: " << p.threads << ", max_boxes: " << p.max_boxes
+      << ", deadline: " << p.deadline << " s\n"
+      << "  cache_dir: " << (p.cache_dir.empty() ? "(none)" : p.cache_dir);
+  return out.str();
+}
+
+Params loadParams(const ros::NodeHandle& nh)
+{
+  Params p;
+  nh.param("map_file", p.map_file, p.map_file);
+  nh.param("use_map_topic", p.use_map_topic, p.use_map_topic);
+  nh.param("map_simplify_tolerance", p.map_simplify_tolerance, p.map_simplify_tolerance);
+  nh.param("map_min_area", p.map_min_area, p.map_min_area);
+  if (nh.hasParam("map_seed_point") && !nh.getParam("map_seed_point", p.map_seed_point))
+  {
+    p.map_seed_point_malformed = true;
+  }
+  nh.param("map_occupied_threshold", p.map_occupied_threshold, p.map_occupied_threshold);
+  nh.param("measurements_per_batch", p.measurements_per_batch, p.measurements_per_batch);
+  nh.param("batch_stride", p.batch_stride, p.batch_stride);
+  nh.param("mode", p.mode, p.mode);
+  nh.param("beams_per_scan", p.beams_per_scan, p.beams_per_scan);
+  nh.param("transform_tolerance", p.transform_tolerance, p.transform_tolerance);
+  nh.param("relocalize_timeout", p.relocalize_timeout, p.relocalize_timeout);
+  nh.param("publish_tf", p.publish_tf, p.publish_tf);
+  nh.param("tf_publish_rate", p.tf_publish_rate, p.tf_publish_rate);
+  nh.param("global_frame_id", p.global_frame_id, p.global_frame_id);
+  nh.param("odom_frame_id", p.odom_frame_id, p.odom_frame_id);
+  nh.param("base_frame_id", p.base_frame_id, p.base_frame_id);
+  nh.param("range_topic", p.range_topic, p.range_topic);
+  nh.param("scan_topic", p.scan_topic, p.scan_topic);
+  nh.param("engine", p.engine, p.engine);
+  nh.param("method", p.method, p.method);
+  nh.param("resolution", p.resolution, p.resolution);
+  nh.param("theta_resolution", p.theta_resolution, p.theta_resolution);
+  nh.param("min_inliers", p.min_inliers, p.min_inliers);
+  p.agreement_tolerance_set = nh.hasParam("agreement_tolerance");
+  nh.param("agreement_tolerance", p.agreement_tolerance, p.agreement_tolerance);
+  nh.param("uniqueness_distance", p.uniqueness_distance, p.uniqueness_distance);
+  nh.param("uniqueness_angle", p.uniqueness_angle, p.uniqueness_angle);
+  p.range_tolerance_set = nh.hasParam("range_tolerance");
+  nh.param("range_tolerance", p.range_tolerance, p.range_tolerance);
+  nh.param("max_candidates", p.max_candidates, p.max_candidates);
+  nh.param("threads", p.threads, p.threads);
+  nh.param("max_boxes", p.max_boxes, p.max_boxes);
+  nh.param("deadline", p.deadline, p.deadline);
+
+  const char* home_env = std::getenv("HOME");
+  const char* ros_home_env = std::getenv("ROS_HOME");
+  const std::string home = home_env ? home_env : "";
+  const std::string ros_home = ros_home_env ? ros_home_env : "";
+  nh.param("cache_dir", p.cache_dir, defaultCacheDir(expandUser(ros_home, home), home));
+  p.cache_dir = expandUser(p.cache_dir, home);
+  return p;
+}
+
+}  // namespace fdml_localization

@@ -1,0 +1,360 @@
+// fdml_bench: the paper's benchmark protocol (method.md section 5) on any maps. Prints the
+// paper-style table on stdout, progress on stderr, one CSV row per trial with --csv.
+#include "fdml_localization/core/benchmark_runner.h"
+#include "fdml_localization/core/text_parsing.h"
+#include "fdml_localization/core/map_generators.h"
+#include "fdml_localization/core/map_io.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace
+{
+namespace core = fdml_localization::core;
+
+/// Relative radius noise of the --random polygon: radii uniform in [0.65, 1.35] x mean radius,
+/// the standard deviation (0.2) of the public prototype's Gaussian radii.
+constexpr double kRandomRadiusNoise = 0.35;
+
+const char* kUsage =
+    "usage: fdml_bench --map PATH[:SCALE] [--map ...] [--random VERTICES[:SCALE]]\n"
+    "                  --obstacles 10,30 [--radius 0.1] [--k 10] [--min-inliers 6|auto]\n"
+    "                  --resolution 50,100,150,200 --trials 50 [--seed 1]\n"
+    "                  [--method robust|paper|baseline[,...]] [--engine voxel|adaptive] [--threads J]\n"
+    "                  [--moving-obstacles] [--translate] [--noise SIGMA]\n"
+    "                  [--csv FILE] [--markdown FILE]\n"
+    "Scene names: the map file's stem, random<VERTICES> for --random; a SCALE other than 1\n"
+    "appends _x<SCALE> (checkpoint.poly:0.25 -> checkpoint_x0.25, --random 70:2 -> random70_x2).\n";
+
+struct UsageError : std::runtime_error
+{
+  using std::runtime_error::runtime_error;
+};
+
+
+
+std::vector<std::string> splitList(const std::string& text)
+{
+  std::vector<std::string> out;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ','))
+  {
+    out.push_back(item);
+  }
+  return out;
+}
+
+std::vector<int> parseIntList(const std::string& text, const std::string& flag)
+{
+  std::vector<int> out;
+  for (const std::string& item : splitList(text))
+  {
+    out.push_back(core::parseInteger(item, flag));
+  }
+  if (out.empty())
+  {
+    throw UsageError(flag + ": empty list");
+  }
+  return out;
+}
+
+/// Splits "BASE[:SCALE]" on its last ':' when what follows is a number (> 0).
+std::pair<std::string, double> splitScale(const std::string& text, const std::string& flag)
+{
+  const std::size_t colon = text.rfind(':');
+  if (colon == std::string::npos)
+  {
+    return { text, 1.0 };
+  }
+  const double scale = core::parseNumber(text.substr(colon + 1), flag + " scale");
+  if (!(scale > 0.0))
+  {
+    throw UsageError(flag + ": scale " + text.substr(colon + 1) + " must be > 0");
+  }
+  return { text.substr(0, colon), scale };
+}
+
+std::string scaleSuffix(double scale)
+{
+  if (scale == 1.0)
+  {
+    return "";
+  }
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "_x%g", scale);
+  return buf;
+}
+
+core::BenchScene mapScene(const std::string& spec)
+{
+  const auto [path, scale] = splitScale(spec, "--map");
+  const std::size_t slash = path.find_last_of('/');
+  std::string stem = slash == std::string::npos ? path : path.substr(slash + 1);
+  const std::size_t dot = stem.rfind('.');
+  if (dot != std::string::npos && dot > 0)
+  {
+    stem = stem.substr(0, dot);
+  }
+  core::PolygonMap map = core::loadPolyFile(path);
+  if (scale != 1.0)
+  {
+    map = map.scaled(scale);
+  }
+  return { stem + scaleSuffix(scale), std::make_shared<const core::MapRayCaster>(std::move(map)) };
+}
+
+core::BenchScene randomScene(const std::string& spec, std::uint64_t seed)
+{
+  const auto [count, scale] = splitScale(spec, "--random");
+  const int vertices = core::parseInteger(count, "--random");
+  if (vertices < 3 || vertices > 100000)
+  {
+    throw UsageError("--random: VERTICES = " + count + " must be in [3, 100000]");
+  }
+  core::PolygonMap map = core::randomPolygon(vertices, 1.0, kRandomRadiusNoise, seed).scaled(scale);
+  return { "random" + std::to_string(vertices) + scaleSuffix(scale),
+           std::make_shared<const core::MapRayCaster>(std::move(map)) };
+}
+
+struct Cli
+{
+  core::BenchConfig config;
+  std::vector<std::string> maps;
+  std::vector<std::string> randoms;
+  std::string csv;
+  std::string markdown;
+};
+
+Cli parseArgs(int argc, char** argv)
+{
+  Cli cli;
+  core::BenchConfig& c = cli.config;
+  c.methods.clear();
+  for (int i = 1; i < argc; ++i)
+  {
+    const std::string flag = argv[i];
+    const auto value = [&]() -> std::string {
+      if (i + 1 >= argc)
+      {
+        throw UsageError(flag + " needs a value");
+      }
+      return argv[++i];
+    };
+    if (flag == "--help" || flag == "-h")
+    {
+      std::cout << kUsage;
+      std::exit(0);
+    }
+    else if (flag == "--map")
+    {
+      cli.maps.push_back(value());
+    }
+    else if (flag == "--random")
+    {
+      cli.randoms.push_back(value());
+    }
+    else if (flag == "--obstacles")
+    {
+      c.obstacles = parseIntList(value(), flag);
+    }
+    else if (flag == "--radius")
+    {
+      c.protocol.obstacle_radius = core::parseNumber(value(), flag);
+    }
+    else if (flag == "--k")
+    {
+      c.protocol.readings = core::parseInteger(value(), flag);
+    }
+    else if (flag == "--min-inliers")
+    {
+      const std::string v = value();
+      c.min_inliers = v == "auto" ? 0 : core::parseInteger(v, flag);
+    }
+    else if (flag == "--resolution")
+    {
+      c.resolutions = parseIntList(value(), flag);
+    }
+    else if (flag == "--trials")
+    {
+      c.trials = core::parseInteger(value(), flag);
+    }
+    else if (flag == "--seed")
+    {
+      const int seed = core::parseInteger(value(), flag);
+      if (seed < 0)
+      {
+        throw UsageError("--seed must be >= 0");
+      }
+      c.seed = static_cast<std::uint64_t>(seed);
+    }
+    else if (flag == "--method")
+    {
+      for (const std::string& m : splitList(value()))
+      {
+        try
+        {
+          c.methods.push_back(core::parseMethod(m));
+        }
+        catch (const std::invalid_argument&)
+        {
+          throw UsageError("--method: '" + m + "' is not one of robust, paper, baseline");
+        }
+      }
+    }
+    else if (flag == "--engine")
+    {
+      const std::string e = value();
+      try
+      {
+        c.engine = core::parseEngine(e);
+      }
+      catch (const std::invalid_argument&)
+      {
+        throw UsageError("--engine: '" + e + "' is not one of voxel, adaptive");
+      }
+    }
+    else if (flag == "--threads")
+    {
+      c.threads = core::parseInteger(value(), flag);
+    }
+    else if (flag == "--moving-obstacles")
+    {
+      c.protocol.moving_obstacles = true;
+    }
+    else if (flag == "--translate")
+    {
+      c.protocol.translate = true;
+    }
+    else if (flag == "--noise")
+    {
+      c.protocol.noise = core::parseNumber(value(), flag);
+    }
+    else if (flag == "--csv")
+    {
+      cli.csv = value();
+    }
+    else if (flag == "--markdown")
+    {
+      cli.markdown = value();
+    }
+    else
+    {
+      throw UsageError("unknown option '" + flag + "'");
+    }
+  }
+  if (c.methods.empty())
+  {
+    c.methods.push_back(core::Method::Robust);
+  }
+  return cli;
+}
+
+std::string commandLine(int argc, char** argv)
+{
+  std::string out = "fdml_bench";
+  for (int i = 1; i < argc; ++i)
+  {
+    out += std::string(" ") + argv[i];
+  }
+  return out;
+}
+
+std::string utcNow()
+{
+  const std::time_t now = std::time(nullptr);
+  char buf[64];
+  std::strftime(buf, sizeof(buf), "%Y-%m-%d %H:%M:%S UTC", std::gmtime(&now));
+  return buf;
+}
+}  // namespace
+
+int main(int argc, char** argv)
+{
+  Cli cli;
+  try
+  {
+    cli = parseArgs(argc, argv);
+    for (const std::string& spec : cli.maps)
+    {
+      cli.config.scenes.push_back(mapScene(spec));
+    }
+    for (const std::string& spec : cli.randoms)
+    {
+      cli.config.scenes.push_back(randomScene(spec, cli.config.seed));
+    }
+    const std::vector<std::string> issues = core::validate(cli.config);
+    if (!issues.empty())
+    {
+      std::string msg = "invalid options:";
+      for (const std::string& s : issues)
+      {
+        msg += "\n  " + s;
+      }
+      throw UsageError(msg);
+    }
+  }
+  catch (const std::exception& e)
+  {
+    std::cerr << "fdml_bench: " << e.what() << "\n" << kUsage;
+    return 2;
+  }
+
+  try
+  {
+    std::ofstream csv;
+    if (!cli.csv.empty())
+    {
+      csv.open(cli.csv);
+      if (!csv)
+      {
+        throw std::runtime_error("--csv: cannot write '" + cli.csv + "'");
+      }
+      csv << core::csvHeader() << '\n' << std::flush;
+    }
+    const auto on_row = [&csv](const core::BenchRow& row) {
+      if (csv.is_open())
+      {
+        csv << core::csvRow(row) << '\n' << std::flush;
+      }
+    };
+    const std::string started = utcNow();
+    const core::BenchRun run = core::runBenchmark(cli.config, on_row, &std::cerr);
+    const std::vector<core::BenchSummary> summary = core::summarize(run.rows, run.tables);
+    std::cout << core::formatTable(summary) << "\nPaper-style table (success pooled over n):\n"
+              << core::formatPaperTable(summary);
+    if (!cli.markdown.empty())
+    {
+      std::ofstream md(cli.markdown);
+      if (!md)
+      {
+        throw std::runtime_error("--markdown: cannot write '" + cli.markdown + "'");
+      }
+      md << "Command: `" << commandLine(argc, argv) << "`  \nStarted: " << started << ", finished: " << utcNow()
+         << "  \nSparsity k' = " << core::sparsityKPrime(cli.config) << "\n\n"
+         << core::formatMarkdownTable(summary) << "\nPaper-style (pooled over n):\n\n"
+         << core::formatPaperTable(summary);
+    }
+  }
+  catch (const std::exception& e)
+  {
+    if (cli.config.engine == core::Engine::Adaptive)
+    {
+      std::cerr << "fdml_bench: --engine adaptive failed (is the adaptive engine available?): " << e.what() << "\n";
+    }
+    else
+    {
+      std::cerr << "fdml_bench: " << e.what() << "\n";
+    }
+    return 1;
+  }
+  return 0;
+}

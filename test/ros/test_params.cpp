@@ -1,0 +1,395 @@
+// Parameter validation of the localizer node (pure, no roscore).
+#include "fdml_localization/ros/params.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+
+namespace fdml_localization
+{
+namespace
+{
+Params validParams()
+{
+  Params params;
+  params.map_file = "package://fdml_localization/maps/square_room.poly";
+  return params;
+}
+
+/// The errors mentioning "~name".
+std::vector<std::string> errorsNaming(const std::vector<std::string>& errors, const std::string& name)
+{
+  std::vector<std::string> out;
+  for (const std::string& error : errors)
+  {
+    if (error.find("~" + name + " ") != std::string::npos)
+    {
+      out.push_back(error);
+    }
+  }
+  return out;
+}
+
+TEST(Params, DefaultsAreValidOnceTheMapIsGiven)
+{
+  EXPECT_TRUE(validate(validParams()).empty());
+  const std::vector<std::string> errors = validate(Params());
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_NE(errors[0].find("~map_file"), std::string::npos);
+  EXPECT_NE(errors[0].find("required"), std::string::npos);
+}
+
+TEST(Params, EachOutOfRangeValueNamesItsParameterAndRange)
+{
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  struct Case
+  {
+    const char* name;
+    std::function<void(Params&)> set;
+    const char* range;
+  };
+  const std::vector<Case> cases = {
+    { "measurements_per_batch", [](Params& p) { p.measurements_per_batch = 2; }, "[3, 255]" },
+    { "measurements_per_batch", [](Params& p) { p.measurements_per_batch = 256; }, "[3, 255]" },
+    { "batch_stride", [](Params& p) { p.batch_stride = 11; }, "[1, ~measurements_per_batch]" },
+    { "batch_stride", [](Params& p) { p.batch_stride = 0; }, "[1, ~measurements_per_batch]" },
+    { "mode", [](Params& p) { p.mode = "sometimes"; }, "\"on_request\" or \"continuous\"" },
+    { "beams_per_scan", [](Params& p) { p.beams_per_scan = 0; }, "[1, 1000]" },
+    { "transform_tolerance", [](Params& p) { p.transform_tolerance = -0.1; }, "[0, 10] s" },
+    { "transform_tolerance", [nan](Params& p) { p.transform_tolerance = nan; }, "[0, 10] s" },
+    { "relocalize_timeout", [](Params& p) { p.relocalize_timeout = 0.0; }, "(0, 3600] s" },
+    { "tf_publish_rate", [](Params& p) { p.tf_publish_rate = 0.0; }, "(0, 1000] Hz" },
+    { "global_frame_id", [](Params& p) { p.global_frame_id = ""; }, "non-empty" },
+    { "base_frame_id", [](Params& p) { p.base_frame_id = "base link"; }, "without spaces" },
+    { "odom_frame_id", [](Params& p) { p.odom_frame_id = "base_link"; }, "different" },
+    { "range_topic", [](Params& p) { p.range_topic = ""; }, "non-empty" },
+    { "engine", [](Params& p) { p.engine = "quantum"; }, "\"voxel\" or \"adaptive\"" },
+    { "method", [](Params& p) { p.method = "magic"; }, "\"robust\", \"paper\" or \"baseline\"" },
+    { "resolution", [](Params& p) { p.resolution = 15; }, "[16, 1024]" },
+    { "resolution", [](Params& p) { p.resolution = 1025; }, "[16, 1024]" },
+    { "theta_resolution", [](Params& p) { p.theta_resolution = 15; }, "[16, 1024]" },
+    { "min_inliers", [](Params& p) { p.min_inliers = 2; }, "[3, ~measurements_per_batch]" },
+    { "min_inliers", [](Params& p) { p.min_inliers = 11; }, "[3, ~measurements_per_batch]" },
+    { "min_inliers", [](Params& p) { p.method = "paper"; }, "with ~method paper" },
+    { "agreement_tolerance", [](Params& p) { p.agreement_tolerance = 0.0; }, "(0, 10] m" },
+    { "uniqueness_distance", [](Params& p) { p.uniqueness_distance = -1.0; }, "[0, 100] m" },
+    { "uniqueness_angle", [](Params& p) { p.uniqueness_angle = 4.0; }, "[0, pi] rad" },
+    { "range_tolerance", [](Params& p) { p.range_tolerance = -0.01; }, "[0, 10] m" },
+    { "max_candidates", [](Params& p) { p.max_candidates = 0; }, "[1, 10000]" },
+    { "threads", [](Params& p) { p.threads = -1; }, "[1, 1024]" },
+    { "max_boxes", [](Params& p) { p.max_boxes = 10; }, ">= 1000" },
+    { "deadline", [](Params& p) { p.deadline = -1.0; }, "(0, 3600] s" },
+  };
+  for (const Case& c : cases)
+  {
+    Params params = validParams();
+    c.set(params);
+    const std::vector<std::string> errors = validate(params);
+    ASSERT_EQ(errors.size(), 1u) << c.name << ": " << (errors.empty() ? "" : errors[0]);
+    EXPECT_EQ(errorsNaming(errors, c.name).size(), 1u) << errors[0];
+    EXPECT_NE(errors[0].find(c.range), std::string::npos) << errors[0];
+  }
+}
+
+TEST(Params, EveryProblemIsReportedAtOnce)
+{
+  Params params;
+  params.resolution = 3;
+  params.mode = "x";
+  params.agreement_tolerance = -1.0;
+  params.measurements_per_batch = 10;
+  params.min_inliers = 12;
+  const std::vector<std::string> errors = validate(params);
+  EXPECT_EQ(errors.size(), 5u);
+  for (const char* name : { "map_file", "resolution", "mode", "agreement_tolerance", "min_inliers" })
+  {
+    bool found = false;
+    for (const std::string& error : errors)
+    {
+      found = found || error.find(std::string("~") + name) != std::string::npos;
+    }
+    EXPECT_TRUE(found) << name;
+  }
+}
+
+TEST(Params, LimitsAreInclusive)
+{
+  Params params = validParams();
+  params.measurements_per_batch = 3;
+  params.batch_stride = 3;
+  params.min_inliers = 3;
+  params.resolution = 16;
+  params.theta_resolution = 1024;
+  params.measurements_per_batch = 255;
+  EXPECT_TRUE(validate(params).empty());
+  params.measurements_per_batch = 3;
+  params.theta_resolution = 16;
+  params.transform_tolerance = 0.0;
+  params.mode = "continuous";
+  EXPECT_TRUE(validate(params).empty());
+}
+
+TEST(Params, CoreOptionsAreCopied)
+{
+  Params params = validParams();
+  params.engine = "adaptive";
+  params.method = "baseline";
+  params.resolution = 64;
+  params.theta_resolution = 72;
+  params.min_inliers = 6;
+  params.agreement_tolerance = 0.03;
+  params.uniqueness_distance = 0.2;
+  params.uniqueness_angle = 0.3;
+  params.range_tolerance = 0.04;
+  params.max_candidates = 5;
+  params.threads = 2;
+  params.cache_dir = "/tmp/cache";
+  params.max_boxes = 5000;
+  params.deadline = 1.5;
+  const core::LocalizerOptions options = toLocalizerOptions(params);
+  EXPECT_EQ(options.engine, core::Engine::Adaptive);
+  EXPECT_EQ(options.method, core::Method::Baseline);
+  EXPECT_EQ(options.resolution, 64);
+  EXPECT_EQ(options.theta_resolution, 72);
+  EXPECT_EQ(options.min_inliers, 6);
+  EXPECT_EQ(options.agreement_tolerance, 0.03);
+  EXPECT_EQ(options.uniqueness_distance, 0.2);
+  EXPECT_EQ(options.uniqueness_angle, 0.3);
+  EXPECT_EQ(options.range_tolerance, 0.04);
+  EXPECT_EQ(options.max_candidates, 5);
+  EXPECT_EQ(options.threads, 2);
+  EXPECT_EQ(options.cache_dir, "/tmp/cache");
+  EXPECT_EQ(options.max_boxes, 5000);
+  EXPECT_EQ(options.deadline, 1.5);
+  params.method = "paper";
+  params.engine = "voxel";
+  EXPECT_EQ(toLocalizerOptions(params).method, core::Method::Paper);
+  EXPECT_EQ(toLocalizerOptions(params).engine, core::Engine::Voxel);
+}
+
+TEST(Params, AgreesWithTheCoreValidation)
+{
+  // What the node accepts, the core accepts ...
+  std::vector<std::function<void(Params&)>> accepted = {
+    [](Params&) {},
+    [](Params& p) {
+      p.resolution = 16;
+      p.theta_resolution = 1024;
+      p.min_inliers = 3;
+    },
+    [](Params& p) {
+      p.resolution = 1024;
+      p.theta_resolution = 16;
+      p.measurements_per_batch = 255;
+      p.min_inliers = 255;
+    },
+    [](Params& p) {
+      p.method = "paper";
+      p.min_inliers = 6;
+    },
+    [](Params& p) { p.method = "baseline"; },
+    [](Params& p) {
+      p.engine = "adaptive";
+      p.resolution = 100000;
+      p.theta_resolution = 7200;
+    },
+    [](Params& p) {
+      p.agreement_tolerance = 10.0;
+      p.uniqueness_distance = 0.0;
+      p.uniqueness_angle = 0.0;
+      p.range_tolerance = 0.0;
+      p.max_candidates = 1;
+      p.threads = 1;
+      p.max_boxes = 1000;
+      p.deadline = 3600.0;
+    },
+  };
+  for (std::size_t i = 0; i < accepted.size(); ++i)
+  {
+    Params params = validParams();
+    accepted[i](params);
+    EXPECT_TRUE(validate(params).empty()) << i;
+    const std::vector<std::string> core_errors = core::validate(toLocalizerOptions(params));
+    EXPECT_TRUE(core_errors.empty()) << i << ": " << (core_errors.empty() ? "" : core_errors[0]);
+  }
+  // ... and every core option the core rejects, the node rejects first (naming the parameter).
+  std::vector<std::function<void(Params&)>> rejected = {
+    [](Params& p) { p.resolution = 15; },         [](Params& p) { p.resolution = 1025; },
+    [](Params& p) {
+      p.engine = "adaptive";
+      p.resolution = 100001;
+    },
+    [](Params& p) { p.theta_resolution = 15; },   [](Params& p) { p.min_inliers = 2; },
+    [](Params& p) { p.agreement_tolerance = 0.0; }, [](Params& p) { p.uniqueness_distance = -1.0; },
+    [](Params& p) { p.uniqueness_angle = -1.0; }, [](Params& p) { p.range_tolerance = -0.01; },
+    [](Params& p) { p.max_candidates = 0; },      [](Params& p) { p.threads = -1; },
+    [](Params& p) { p.max_boxes = 999; },         [](Params& p) { p.deadline = -1.0; },
+    [](Params& p) { p.method = "paper"; },
+  };
+  for (std::size_t i = 0; i < rejected.size(); ++i)
+  {
+    Params params = validParams();
+    rejected[i](params);
+    EXPECT_FALSE(core::validate(toLocalizerOptions(params)).empty()) << i;
+    EXPECT_FALSE(validate(params).empty()) << i;
+  }
+}
+
+TEST(Params, ModeParsing)
+{
+  SolveMode mode = SolveMode::OnRequest;
+  EXPECT_TRUE(parseSolveMode("continuous", &mode));
+  EXPECT_EQ(mode, SolveMode::Continuous);
+  EXPECT_TRUE(parseSolveMode("on_request", &mode));
+  EXPECT_EQ(mode, SolveMode::OnRequest);
+  EXPECT_FALSE(parseSolveMode("Continuous", &mode));
+  EXPECT_STREQ(toString(SolveMode::Continuous), "continuous");
+}
+
+TEST(Params, CacheDirExpansion)
+{
+  EXPECT_EQ(expandUser("~/.ros/x", "/home/u"), "/home/u/.ros/x");
+  EXPECT_EQ(expandUser("~", "/home/u"), "/home/u");
+  EXPECT_EQ(expandUser("/abs/~/x", "/home/u"), "/abs/~/x");
+  EXPECT_EQ(expandUser("~other/x", "/home/u"), "~other/x");
+  EXPECT_EQ(defaultCacheDir("/ros_home", "/home/u"), "/ros_home/fdml_localization");
+  EXPECT_EQ(defaultCacheDir("", "/home/u"), "/home/u/.ros/fdml_localization");
+}
+
+TEST(Params, DescribeListsEveryParameter)
+{
+  const std::string text = describe(validParams());
+  for (const char* name :
+       { "map_file", "measurements_per_batch", "batch_stride", "mode", "beams_per_scan", "transform_tolerance",
+         "relocalize_timeout", "publish_tf", "engine", "method", "resolution", "theta_resolution", "min_inliers",
+         "agreement_tolerance", "uniqueness_distance", "uniqueness_angle", "range_tolerance", "max_candidates",
+         "threads", "cache_dir", "max_boxes", "deadline" })
+  {
+    EXPECT_NE(text.find(name), std::string::npos) << name;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Occupancy-grid maps (issue 9).
+// ---------------------------------------------------------------------------------------------
+
+TEST(Params, MapTopicMakesTheMapFileOptional)
+{
+  Params params;
+  params.use_map_topic = true;
+  EXPECT_TRUE(validate(params).empty());
+  params.map_file = "package://fdml_localization/maps/office_grid.yaml";  // an initial map
+  EXPECT_TRUE(validate(params).empty());
+  params.use_map_topic = false;
+  params.map_file.clear();
+  const std::vector<std::string> errors = validate(params);
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_NE(errors[0].find("~map_file is required unless ~use_map_topic is true"), std::string::npos) << errors[0];
+}
+
+TEST(Params, GridConversionParametersAreValidated)
+{
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  struct Case
+  {
+    const char* name;
+    std::function<void(Params&)> set;
+    const char* range;
+  };
+  const std::vector<Case> cases = {
+    { "map_simplify_tolerance", [](Params& p) { p.map_simplify_tolerance = -0.01; }, "(0, 10] m" },
+    { "map_simplify_tolerance", [](Params& p) { p.map_simplify_tolerance = 10.5; }, "(0, 10] m" },
+    { "map_simplify_tolerance", [nan](Params& p) { p.map_simplify_tolerance = nan; }, "(0, 10] m" },
+    { "map_min_area", [nan](Params& p) { p.map_min_area = nan; }, "[0, 1e6] m^2" },
+    { "map_min_area", [inf](Params& p) { p.map_min_area = inf; }, "[0, 1e6] m^2" },
+    { "map_seed_point", [](Params& p) { p.map_seed_point = { 1.0 }; }, "two finite numbers" },
+    { "map_seed_point", [](Params& p) { p.map_seed_point = { 1.0, 2.0, 3.0 }; }, "two finite numbers" },
+    { "map_seed_point", [inf](Params& p) { p.map_seed_point = { 1.0, inf }; }, "two finite numbers" },
+    { "map_seed_point", [](Params& p) { p.map_seed_point_malformed = true; }, "two finite numbers" },
+    { "map_occupied_threshold", [](Params& p) { p.map_occupied_threshold = 0; }, "[1, 100]" },
+    { "map_occupied_threshold", [](Params& p) { p.map_occupied_threshold = 101; }, "[1, 100]" },
+  };
+  for (const Case& c : cases)
+  {
+    Params params = validParams();
+    c.set(params);
+    const std::vector<std::string> errors = validate(params);
+    ASSERT_EQ(errors.size(), 1u) << c.name << ": " << (errors.empty() ? "" : errors[0]);
+    EXPECT_EQ(errorsNaming(errors, c.name).size(), 1u) << errors[0];
+    EXPECT_NE(errors[0].find(c.range), std::string::npos) << errors[0];
+  }
+
+  // Limits and the "automatic" values are accepted and reach the core options.
+  Params params = validParams();
+  params.map_simplify_tolerance = 10.0;
+  params.map_min_area = -5.0;
+  params.map_seed_point = { 1.5, -2.5 };
+  params.map_occupied_threshold = 100;
+  EXPECT_TRUE(validate(params).empty());
+  core::GridConversionOptions options = toGridOptions(params);
+  EXPECT_EQ(options.tolerance, 10.0);
+  EXPECT_EQ(options.min_area, -5.0);
+  EXPECT_TRUE(options.use_seed);
+  EXPECT_EQ(options.seed_point, core::Vec2(1.5, -2.5));
+  EXPECT_EQ(options.occupied_threshold, 100);
+  params.map_seed_point.clear();
+  params.map_occupied_threshold = 1;
+  params.map_min_area = 1e6;
+  EXPECT_TRUE(validate(params).empty());
+  EXPECT_FALSE(toGridOptions(params).use_seed);
+  EXPECT_EQ(toGridOptions(params).occupied_threshold, 1);
+  // Defaults: one cell, ten cells, the largest region, as the core's defaults.
+  const core::GridConversionOptions defaults = toGridOptions(validParams());
+  const core::GridConversionOptions core_defaults;
+  EXPECT_EQ(defaults.tolerance, core_defaults.tolerance);
+  EXPECT_EQ(defaults.min_area, core_defaults.min_area);
+  EXPECT_EQ(defaults.use_seed, core_defaults.use_seed);
+  EXPECT_EQ(defaults.occupied_threshold, core_defaults.occupied_threshold);
+}
+
+TEST(Params, GridMapsWidenTheTolerancesTheUserDidNotSet)
+{
+  const Params defaults = validParams();
+  // A 5 cm grid: one cell of range tolerance, two of agreement.
+  Params grid = withGridTolerances(defaults, 0.05);
+  EXPECT_DOUBLE_EQ(grid.range_tolerance, 0.05);
+  EXPECT_DOUBLE_EQ(grid.agreement_tolerance, 0.10);
+  // A fine 1 cm grid never goes below the defaults.
+  grid = withGridTolerances(defaults, 0.01);
+  EXPECT_DOUBLE_EQ(grid.range_tolerance, defaults.range_tolerance);
+  EXPECT_DOUBLE_EQ(grid.agreement_tolerance, defaults.agreement_tolerance);
+  // A polygon map (resolution 0) changes nothing.
+  grid = withGridTolerances(defaults, 0.0);
+  EXPECT_EQ(grid.range_tolerance, defaults.range_tolerance);
+  EXPECT_EQ(grid.agreement_tolerance, defaults.agreement_tolerance);
+  // Values the user set are kept, each on its own.
+  Params set = validParams();
+  set.range_tolerance = 0.01;
+  set.range_tolerance_set = true;
+  grid = withGridTolerances(set, 0.1);
+  EXPECT_EQ(grid.range_tolerance, 0.01);
+  EXPECT_DOUBLE_EQ(grid.agreement_tolerance, 0.2);
+  set.agreement_tolerance = 0.03;
+  set.agreement_tolerance_set = true;
+  grid = withGridTolerances(set, 0.1);
+  EXPECT_EQ(grid.range_tolerance, 0.01);
+  EXPECT_EQ(grid.agreement_tolerance, 0.03);
+  // And they reach the core options.
+  EXPECT_DOUBLE_EQ(toLocalizerOptions(withGridTolerances(defaults, 0.05)).range_tolerance, 0.05);
+}
+
+TEST(Params, DescribeListsTheMapParameters)
+{
+  const std::string text = describe(validParams());
+  for (const char* name : { "use_map_topic", "map_simplify_tolerance", "map_min_area", "map_seed_point",
+                            "map_occupied_threshold" })
+  {
+    EXPECT_NE(text.find(name), std::string::npos) << name;
+  }
+}
+
+}  // namespace
+}  // namespace fdml_localization

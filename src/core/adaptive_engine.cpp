@@ -1,9 +1,7 @@
 #include "fdml_localization/core/adaptive_engine.h"
 
-#include "fdml_localization/core/candidate_refinement.h"
-
 #include <algorithm>
-#include <chrono>
+#include <cmath>
 #include <numeric>
 #include <unordered_map>
 
@@ -13,11 +11,6 @@ namespace core
 {
 namespace
 {
-double secondsSince(std::chrono::steady_clock::time_point start)
-{
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 /// Union-find over leaf indices.
 class DisjointSets
 {
@@ -174,6 +167,77 @@ std::vector<LeafCluster> clusterLeaves(const std::vector<LeafBox>& leaves, int l
   return clusters;
 }
 
+std::vector<LeafCluster> leafMaxima(const std::vector<LeafBox>& leaves, int level, std::int64_t theta_cells)
+{
+  std::unordered_map<std::uint64_t, std::size_t> index;
+  std::vector<std::size_t> plateau;
+  for (std::size_t i = 0; i < leaves.size(); ++i)
+  {
+    if (leaves[i].count >= level)
+    {
+      index.emplace(cellKey(leaves[i].ix, leaves[i].iy, leaves[i].it), i);
+    }
+    if (leaves[i].count == level)
+    {
+      plateau.push_back(i);
+    }
+  }
+  DisjointSets sets(leaves.size());
+  std::vector<char> dominated(leaves.size(), 0);
+  for (const std::size_t i : plateau)
+  {
+    const LeafBox& l = leaves[i];
+    for (int dt = -1; dt <= 1; ++dt)
+    {
+      const std::int64_t t = ((l.it + dt) % theta_cells + theta_cells) % theta_cells;
+      for (int dy = -1; dy <= 1; ++dy)
+      {
+        for (int dx = -1; dx <= 1; ++dx)
+        {
+          const auto found = index.find(cellKey(l.ix + dx, l.iy + dy, t));
+          if (l.ix + dx < 0 || l.iy + dy < 0 || found == index.end())
+          {
+            continue;
+          }
+          if (leaves[found->second].count > level)
+          {
+            dominated[i] = 1;
+          }
+          else
+          {
+            sets.unite(i, found->second);
+          }
+        }
+      }
+    }
+  }
+  std::unordered_map<std::size_t, std::vector<std::size_t>> parts;
+  for (const std::size_t i : plateau)
+  {
+    parts[sets.find(i)].push_back(i);
+  }
+  std::vector<LeafCluster> maxima;
+  for (auto& part : parts)
+  {
+    std::vector<std::size_t>& members = part.second;
+    if (std::any_of(members.begin(), members.end(), [&](std::size_t i) { return dominated[i] != 0; }))
+    {
+      continue;
+    }
+    std::sort(members.begin(), members.end());
+    LeafCluster c = plateauCluster(leaves, members);
+    c.size = members.size();
+    c.peak_count = level;
+    c.members = std::move(members);
+    maxima.push_back(std::move(c));
+  }
+  // Deterministic order: largest plateau first, then position.
+  std::sort(maxima.begin(), maxima.end(), [](const LeafCluster& a, const LeafCluster& b) {
+    return a.size != b.size ? a.size > b.size : a.representative < b.representative;
+  });
+  return maxima;
+}
+
 AdaptiveEngine::AdaptiveEngine(std::shared_ptr<const MapRayCaster> map, const LocalizerOptions& options)
   : map_(std::move(map)), options_(options)
 {
@@ -181,6 +245,7 @@ AdaptiveEngine::AdaptiveEngine(std::shared_ptr<const MapRayCaster> map, const Lo
   cell_xy_ = std::max(size.x(), size.y()) / options_.resolution;
   const int nt = options_.theta_resolution > 0 ? options_.theta_resolution : options_.resolution;
   cell_theta_ = kTwoPi / nt;
+  occupancy_ = std::make_shared<const BoxOccupancy>(*map_, cell_xy_, kOccupancyCells);
 }
 
 AdaptiveSearchOptions AdaptiveEngine::searchOptions(int min_count) const
@@ -194,89 +259,6 @@ AdaptiveSearchOptions AdaptiveEngine::searchOptions(int min_count) const
   o.deadline = options_.deadline;
   o.threads = options_.threads;
   return o;
-}
-
-Result AdaptiveEngine::localize(const std::vector<Reading>& readings)
-{
-  const auto start = std::chrono::steady_clock::now();
-  Result result;
-  result.engine = Engine::Adaptive;
-  result.method = options_.method;
-  const int k = static_cast<int>(readings.size());
-  result.readings_used = k;
-  const std::int64_t theta_cells = std::max<std::int64_t>(1, std::llround(kTwoPi / cell_theta_));
-
-  const bool automatic = options_.method == Method::Robust && options_.min_inliers <= 0;
-  int lowest = options_.method == Method::Baseline ? k : options_.min_inliers;
-  if (automatic)
-  {
-    lowest = 3;
-  }
-  const bool polish = options_.method == Method::Robust;
-
-  RefinementSettings settings;
-  settings.agreement_tolerance = options_.agreement_tolerance;
-  settings.robust_scale = std::max(options_.agreement_tolerance, 3.0 * cell_xy_);
-  settings.noise_sigma = std::max(options_.range_tolerance / std::sqrt(3.0), 1e-4);
-
-  std::vector<Candidate> kept;
-  int used_level = lowest;
-  // Maximum consensus: search for k' = k first and lower it until a verified candidate appears.
-  // With a fixed k' (or the paper's and the baseline's semantics) there is one search.
-  for (int level = automatic ? k : lowest; level >= lowest; --level)
-  {
-    auto stage = std::chrono::steady_clock::now();
-    const AdaptiveSearchResult search = adaptiveSearch(*map_, readings, searchOptions(level));
-    result.times.preimages += secondsSince(stage);
-    result.boxes_per_level = search.boxes_per_level;
-    result.truncated = search.truncated;
-
-    stage = std::chrono::steady_clock::now();
-    const std::vector<LeafCluster> clusters = clusterLeaves(search.leaves, level, theta_cells);
-    result.times.components += secondsSince(stage);
-
-    stage = std::chrono::steady_clock::now();
-    std::vector<Candidate> found(clusters.size());
-#pragma omp parallel for schedule(dynamic, 1)
-    for (long c = 0; c < static_cast<long>(clusters.size()); ++c)
-    {
-      const LeafCluster& cluster = clusters[c];
-      if (polish)
-      {
-        std::vector<bool> hypothesis(readings.size(), true);
-        const std::uint64_t mask = search.leaves[cluster.representative].mask;
-        for (std::size_t i = 0; i < readings.size() && i < 64; ++i)
-        {
-          hypothesis[i] = ((mask >> i) & 1U) != 0;
-        }
-        found[c] = refineSeed(*map_, cluster.centroid, readings, hypothesis, settings);
-      }
-      else
-      {
-        found[c] = verifiedCandidate(*map_, cluster.centroid, readings, options_.agreement_tolerance);
-      }
-      found[c].support = static_cast<double>(cluster.size);
-    }
-    (polish ? result.times.polish : result.times.verification) += secondsSince(stage);
-
-    for (Candidate& c : found)
-    {
-      if (c.inliers >= level)
-      {
-        kept.push_back(std::move(c));
-      }
-    }
-    used_level = level;
-    if (!kept.empty())
-    {
-      break;
-    }
-  }
-  result.min_inliers_used = used_level;
-  result.candidates = rankAndDeduplicate(std::move(kept), options_.uniqueness_distance, options_.uniqueness_angle,
-                                         options_.max_candidates);
-  result.times.total = secondsSince(start);
-  return result;
 }
 
 }  // namespace core

@@ -1,6 +1,7 @@
 // Shared helpers of the localizer tests: maps, random poses and simulated readings.
 #pragma once
 
+#include "fdml_localization/core/adaptive_search.h"
 #include "fdml_localization/core/components.h"
 #include "fdml_localization/core/localizer.h"
 #include "fdml_localization/core/map_io.h"
@@ -18,6 +19,13 @@ namespace core
 {
 namespace test
 {
+#ifndef FDML_TEST_ENGINE
+#define FDML_TEST_ENGINE Voxel
+#endif
+/// The engine the shared correctness tests run on: the same test sources are compiled once per
+/// engine (test_core_localizer: voxel, test_core_adaptive: adaptive).
+constexpr Engine kTestEngine = Engine::FDML_TEST_ENGINE;
+
 /// An L-shaped 8 x 6 m room with a square pillar and a triangular obstacle.
 inline std::shared_ptr<const MapRayCaster> lRoomMap()
 {
@@ -127,6 +135,21 @@ inline bool truthInSet(const GridSpec& spec, const std::vector<std::uint8_t>& co
   bool found = count[spec.index(ix, iy, it)] >= level;
   forEachNeighbour(spec, ix, iy, it, [&](std::size_t v) { found = found || count[v] >= level; });
   return found;
+}
+
+/// True when a leaf box of the adaptive search with count >= level holds @p truth.
+inline bool truthInLeaves(const std::vector<LeafBox>& leaves, const Pose2& truth, int level)
+{
+  for (const LeafBox& leaf : leaves)
+  {
+    const PoseBox& b = leaf.box;
+    if (leaf.count >= level && truth.x >= b.x0 && truth.x <= b.x1 && truth.y >= b.y0 && truth.y <= b.y1 &&
+        truth.theta >= b.t0 && truth.theta <= b.t1)
+    {
+      return true;
+    }
+  }
+  return false;
 }
 
 }  // namespace test

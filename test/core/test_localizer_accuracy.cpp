@@ -1,6 +1,7 @@
 // Exact readings on static maps: the truth lies in M_k' (conservativeness) and the polished
 // candidate nearest to it is within 1 mm and 0.05 degrees; theta near +-pi; translation
 // between readings and several sensors with mounting offsets.
+#include "fdml_localization/core/adaptive_engine.h"
 #include "fdml_localization/core/voxel_engine.h"
 
 #include "localizer_test_utils.h"
@@ -34,9 +35,12 @@ AccuracyStats runExactTrials(const std::shared_ptr<const MapRayCaster>& map, int
                              std::uint64_t seed)
 {
   LocalizerOptions options;
+  options.engine = test::kTestEngine;
   options.resolution = resolution;
   options.threads = 1;  // many short calls: keep the suite fast on a loaded machine
-  VoxelEngine engine(map, options);
+  VoxelEngine voxel(map, options);
+  AdaptiveEngine adaptive(map, options);
+  LocalizerEngine& engine = test::kTestEngine == Engine::Voxel ? static_cast<LocalizerEngine&>(voxel) : adaptive;
   std::mt19937_64 rng(seed);
   AccuracyStats stats;
   const std::vector<Pose2> offsets = test::inPlaceOffsets(10);
@@ -48,7 +52,10 @@ AccuracyStats runExactTrials(const std::shared_ptr<const MapRayCaster>& map, int
     const Result result = engine.localize(readings);
     ++stats.trials;
     stats.candidates += static_cast<double>(result.candidates.size());
-    if (test::truthInSet(engine.grid(), engine.lastCount(), truth, result.min_inliers_used))
+    const bool kept = test::kTestEngine == Engine::Voxel ?
+                          test::truthInSet(voxel.grid(), voxel.lastCount(), truth, result.min_inliers_used) :
+                          test::truthInLeaves(adaptive.lastLeaves(), truth, result.min_inliers_used);
+    if (kept)
     {
       ++stats.in_set;
     }
@@ -98,6 +105,7 @@ TEST(LocalizerAccuracy, PoseNearPiIsOneCandidateAtTheRightAngle)
 {
   const auto map = test::lRoomMap();
   LocalizerOptions options;
+  options.engine = test::kTestEngine;
   options.resolution = 64;
   Localizer localizer(map, options);
   for (double theta : { kPi - 0.004, -kPi + 0.004, kPi - 1e-9 })
@@ -140,6 +148,7 @@ TEST(LocalizerAccuracy, TranslationBetweenReadingsAndSeveralSensors)
 {
   const auto map = test::lRoomMap();
   LocalizerOptions options;
+  options.engine = test::kTestEngine;
   options.resolution = 64;
   Localizer localizer(map, options);
   std::mt19937_64 rng(5);

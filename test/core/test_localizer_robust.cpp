@@ -86,6 +86,7 @@ TEST(LocalizerRobust, FourOfTenReadingsHitObstacles)
 {
   const auto map = test::lRoomMap();
   LocalizerOptions robust;
+  robust.engine = test::kTestEngine;
   robust.resolution = 64;
   robust.threads = 1;  // many short calls: keep the suite fast on a loaded machine
   LocalizerOptions fixed = robust;
@@ -129,6 +130,7 @@ TEST(LocalizerRobust, PaperModeFindsComponentCentresWithoutPolish)
 {
   const auto map = test::lRoomMap();
   LocalizerOptions paper;
+  paper.engine = test::kTestEngine;
   paper.resolution = 128;
   paper.method = Method::Paper;
   paper.min_inliers = 6;
@@ -177,6 +179,7 @@ TEST(LocalizerRobust, NoReturnReadingsAreUsedAndAgree)
   // A 2.5 m sensor in the 8 x 6 m room: the longer readings return nothing (range = inf).
   const auto map = test::lRoomMap();
   LocalizerOptions options;
+  options.engine = test::kTestEngine;
   options.resolution = 64;
   Localizer localizer(map, options);
   std::mt19937_64 rng(17);
@@ -220,6 +223,7 @@ TEST(LocalizerRobust, SensorNoiseWithinTheRangeTolerance)
 {
   const auto map = test::lRoomMap();
   LocalizerOptions options;
+  options.engine = test::kTestEngine;
   options.resolution = 64;
   options.range_tolerance = 0.03;
   options.agreement_tolerance = 0.05;

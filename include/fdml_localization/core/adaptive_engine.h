@@ -24,6 +24,7 @@ struct LeafCluster
   std::size_t representative = 0;  ///< index (into the leaves) of the plateau leaf nearest the centroid
   std::size_t size = 0;     ///< leaves in the whole connected component
   int peak_count = 0;
+  std::vector<std::size_t> members;  ///< plateau leaves (leafMaxima only), ascending
 };
 
 /**
@@ -33,6 +34,12 @@ struct LeafCluster
  */
 std::vector<LeafCluster> clusterLeaves(const std::vector<LeafBox>& leaves, int level, std::int64_t theta_cells);
 
+/**
+ * @brief Regional maxima at exactly @p level: connected plateaus (26 neighbours, periodic theta)
+ *        of the leaves with count == level that touch no leaf with a higher count; largest first.
+ */
+std::vector<LeafCluster> leafMaxima(const std::vector<LeafBox>& leaves, int level, std::int64_t theta_cells);
+
 class AdaptiveEngine : public LocalizerEngine
 {
 public:
@@ -40,14 +47,26 @@ public:
   void prepare() override {}
   Result localize(const std::vector<Reading>& readings) override;
 
+  /// The leaves of the last localize() call's search (for tests and diagnostics).
+  const std::vector<LeafBox>& lastLeaves() const { return last_leaves_; }
+
   /// The box-search settings used for a given k'.
   AdaptiveSearchOptions searchOptions(int min_count) const;
 
 private:
+  /// The robust method: regional maxima per k' from k down, polished seeds (as the voxel engine).
+  void localizeRobust(AdaptiveSearch& search, const std::vector<Reading>& readings, Result& result);
+  /// The paper's and the baseline's semantics: one k', verified component centres.
+  void localizeFixed(AdaptiveSearch& search, const std::vector<Reading>& readings, int level, Result& result);
+
   std::shared_ptr<const MapRayCaster> map_;
   LocalizerOptions options_;
   double cell_xy_;     ///< leaf size [m]
   double cell_theta_;  ///< leaf size [rad]
+  std::shared_ptr<const BoxOccupancy> occupancy_;
+  std::vector<LeafBox> last_leaves_;  ///< built once per map
+  /// Cap on the occupancy grid's cells per side (two 4-byte tables: 2048^2 cells = 34 MB).
+  static constexpr int kOccupancyCells = 2048;
 };
 
 }  // namespace core

@@ -11,8 +11,10 @@
  */
 #pragma once
 
+#include "fdml_localization/core/box_occupancy.h"
 #include "fdml_localization/core/localizer.h"
 
+#include <chrono>
 #include <cstdint>
 #include <vector>
 
@@ -49,6 +51,11 @@ struct AdaptiveSearchOptions
   long max_boxes = 20000000;   ///< budget of boxes tested over the whole search
   double deadline = 0.0;       ///< wall-time budget [s]; 0 = none
   int threads = 0;             ///< OpenMP threads; 0 = all
+  /// Lowest k' a resumed search may be asked for (AdaptiveSearch::run); boxes pruned with an
+  /// upper bound of at least this many readings are kept aside for a later, lower k'.
+  int floor_count = 0;
+  /// Levels with at most this many boxes are tested on one thread (no barrier cost).
+  long parallel_threshold = 2000;
 };
 
 /// The outcome of a box search.
@@ -70,6 +77,57 @@ Box2 rotatedArcBounds(const Vec2& v, double t0, double t1);
 /// Runs the search over the map's bounding box x [-pi, pi).
 AdaptiveSearchResult adaptiveSearch(const MapRayCaster& map, const std::vector<Reading>& readings,
                                     const AdaptiveSearchOptions& options);
+
+/// The same search with a prebuilt occupancy grid of the map (see AdaptiveSearch).
+AdaptiveSearchResult adaptiveSearch(const MapRayCaster& map, const BoxOccupancy& occupancy,
+                                    const std::vector<Reading>& readings, const AdaptiveSearchOptions& options);
+
+/**
+ * @brief A resumable search for maximum consensus: run(k1) keeps the leaves with at least k1
+ *        explainable readings; a later run(k2), k2 < k1, adds exactly the leaves with k2 <= count
+ *        < k1 by resuming from the boxes the earlier runs set aside (never testing a box twice at
+ *        the same k'), so lowering k' step by step costs one search, not one per step.
+ */
+class AdaptiveSearch
+{
+public:
+  /// @p occupancy and @p map must outlive the search; options.floor_count bounds later run()s.
+  AdaptiveSearch(const MapRayCaster& map, const BoxOccupancy& occupancy, std::vector<Reading> readings,
+                 const AdaptiveSearchOptions& options);
+
+  /// Searches down to the leaves for k' = @p min_count (>= options.floor_count, not above the
+  /// previous run's) and returns all leaves found so far, with counts >= min_count.
+  const AdaptiveSearchResult& run(int min_count);
+  const AdaptiveSearchResult& result() const { return result_; }
+
+private:
+  struct Node
+  {
+    std::int32_t ix, iy, it;  ///< index of the node's first leaf cell along each axis
+    std::int32_t count;       ///< readings that pass (an upper bound for set-aside nodes)
+    std::uint64_t mask;
+  };
+  PoseBox boxOf(const Node& n, int level) const;
+  /// Tests one node against @p min_count; fills count (exact when kept) and mask.
+  bool test(Node& n, int level, int min_count) const;
+  void prepareArcs(int level);
+
+  const MapRayCaster& map_;
+  const BoxOccupancy& occupancy_;
+  std::vector<Reading> readings_;
+  AdaptiveSearchOptions options_;
+  std::int64_t nx_ = 1, ny_ = 1, nt_ = 1;
+  double cell_t_ = 1.0;
+  int lx_ = 0, ly_ = 0, lt_ = 0, levels_ = 0;
+  std::vector<std::vector<Node>> set_aside_;   ///< per level
+  std::vector<std::vector<Box2>> arcs_;        ///< per level: [theta node * readings * 2] hit / sensor arcs
+  AdaptiveSearchResult result_;
+  bool started_ = false;
+  bool finished_ = false;                      ///< a budget cut the search; no more runs
+  using Clock = std::chrono::steady_clock;
+  Clock::time_point start_;
+  double elapsed_ = 0.0;
+};
 
 }  // namespace core
 }  // namespace fdml_localization

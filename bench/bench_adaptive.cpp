@@ -23,8 +23,9 @@
 #include "fdml_localization/core/scene.h"
 #include "fdml_localization/core/voxel_engine.h"
 
+#include "bench_utils.h"
+
 #include <benchmark/benchmark.h>
-#include <sys/resource.h>
 
 #include <algorithm>
 #include <chrono>
@@ -39,19 +40,14 @@
 namespace
 {
 namespace core = fdml_localization::core;
+using fdml_localization::bench::peakRssMb;
+using fdml_localization::bench::split;
 
 struct Batch
 {
   core::Pose2 truth;
   std::vector<core::Reading> readings;
 };
-
-double peakRssMb()
-{
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_maxrss) / 1024.0;
-}
 
 double envDouble(const char* name, double fallback)
 {
@@ -201,21 +197,6 @@ void runEngine(benchmark::State& state, const std::string& entry, core::Engine e
   state.counters["success"] = static_cast<double>(success) / static_cast<double>(std::max(calls, 1L));
   state.counters["resolution"] = options.resolution;
   state.counters["peak_rss_mb"] = peakRssMb();
-}
-
-std::vector<std::string> split(const std::string& text, char sep)
-{
-  std::vector<std::string> parts;
-  std::stringstream in(text);
-  std::string part;
-  while (std::getline(in, part, sep))
-  {
-    if (!part.empty())
-    {
-      parts.push_back(part);
-    }
-  }
-  return parts;
 }
 
 int registerAll()

@@ -13,8 +13,9 @@
 #include "fdml_localization/core/scene.h"
 #include "fdml_localization/core/voxel_engine.h"
 
+#include "bench_utils.h"
+
 #include <benchmark/benchmark.h>
-#include <sys/resource.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -29,28 +30,8 @@
 namespace
 {
 namespace core = fdml_localization::core;
-
-std::vector<std::string> split(const std::string& text, char sep)
-{
-  std::vector<std::string> parts;
-  std::stringstream in(text);
-  std::string part;
-  while (std::getline(in, part, sep))
-  {
-    if (!part.empty())
-    {
-      parts.push_back(part);
-    }
-  }
-  return parts;
-}
-
-double peakRssMb()
-{
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_maxrss) / 1024.0;
-}
+using fdml_localization::bench::peakRssMb;
+using fdml_localization::bench::split;
 
 std::shared_ptr<const core::MapRayCaster> loadMap(const std::string& path)
 {

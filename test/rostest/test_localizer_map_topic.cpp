@@ -7,6 +7,7 @@
 
 #include "fdml_localization/core/grid_to_polygon.h"
 #include "fdml_localization/ros/conversions.h"
+#include "message_collector.h"
 
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <fdml_localization/Localize.h>
@@ -142,46 +143,6 @@ void expectLocalized(const fdml_localization::Localize::Response& response, cons
   }
 }
 
-/// Keeps the newest message of a topic.
-template <typename Msg>
-class Latest
-{
-public:
-  Latest(ros::NodeHandle& nh, const std::string& topic)
-    : sub_(nh.subscribe<Msg>(topic, 10, [this](const typename Msg::ConstPtr& msg) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      messages_.push_back(*msg);
-    }))
-  {
-  }
-  /// Waits until some message satisfies @p pred; false on timeout.
-  template <typename Pred>
-  bool waitFor(Pred pred, double timeout)
-  {
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout);
-    while (ros::ok() && ros::WallTime::now() < deadline)
-    {
-      {
-        std::lock_guard<std::mutex> lock(mutex_);
-        for (const Msg& msg : messages_)
-        {
-          if (pred(msg))
-          {
-            return true;
-          }
-        }
-      }
-      ros::WallDuration(0.02).sleep();
-    }
-    return false;
-  }
-
-private:
-  std::mutex mutex_;
-  std::vector<Msg> messages_;
-  ros::Subscriber sub_;
-};
-
 /// The value of @p key in a diagnostic status holding it, "" when none does.
 std::string diagnosticValue(const diagnostic_msgs::DiagnosticArray& msg, const std::string& key)
 {
@@ -221,7 +182,7 @@ TEST(LocalizerMapTopic, LocalizesOnAGridFromTheTopic)
 {
   ros::NodeHandle nh;
   TurningScene scene;
-  Latest<visualization_msgs::MarkerArray> markers(nh, "fdml_localizer_topic/map_markers");
+  Collector<visualization_msgs::MarkerArray> markers(nh, "fdml_localizer_topic/map_markers");
   mapPublisher().publish(gridMessage(scene.map->map()));
 
   fdml_localization::Localize::Response response;
@@ -257,7 +218,7 @@ TEST(LocalizerMapTopic, ABadGridIsRejectedAndTheMapStays)
 {
   ros::NodeHandle nh;
   TurningScene scene;
-  Latest<diagnostic_msgs::DiagnosticArray> diagnostics(nh, "/diagnostics");
+  Collector<diagnostic_msgs::DiagnosticArray> diagnostics(nh, "/diagnostics");
   core::OccupancyGrid walls;
   walls.width = 40;
   walls.height = 30;

@@ -4,6 +4,7 @@
 #include "node_test_scene.h"
 
 #include "fdml_localization/ros/conversions.h"
+#include "message_collector.h"
 
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <fdml_localization/Localize.h>
@@ -74,47 +75,6 @@ bool relocalizeWhilePublishing(ros::NodeHandle& nh, ScenePublisher& publisher, i
   *response = outcome.second;
   return outcome.first;
 }
-
-/// Subscribes to a topic and keeps every message.
-template <typename Msg>
-class Collector
-{
-public:
-  Collector(ros::NodeHandle& nh, const std::string& topic)
-    : sub_(nh.subscribe<Msg>(topic, 100, [this](const typename Msg::ConstPtr& msg) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      messages_.push_back(*msg);
-    }))
-  {
-  }
-  /// Waits (spinning via the async spinner) until @p pred holds for a message; false on timeout.
-  template <typename Pred>
-  bool waitFor(Pred pred, double timeout, Msg* found)
-  {
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout);
-    while (ros::WallTime::now() < deadline && ros::ok())
-    {
-      {
-        std::lock_guard<std::mutex> lock(mutex_);
-        for (const Msg& msg : messages_)
-        {
-          if (pred(msg))
-          {
-            *found = msg;
-            return true;
-          }
-        }
-      }
-      ros::WallDuration(0.02).sleep();
-    }
-    return false;
-  }
-
-private:
-  std::mutex mutex_;
-  std::vector<Msg> messages_;
-  ros::Subscriber sub_;
-};
 
 std::uint32_t dropCount(const fdml_localization::LocalizationResult& result, const std::string& reason)
 {

@@ -3,6 +3,7 @@
 #include "fdml_localization/core/adaptive_engine.h"
 
 #include "fdml_localization/core/candidate_refinement.h"
+#include "fdml_localization/core/stopwatch.h"
 
 #include <omp.h>
 
@@ -25,10 +26,6 @@ constexpr std::size_t kSeedsPerPlateau = 3;
 /// ... from plateaus of at least this many leaves (smaller ones give one seed).
 constexpr std::size_t kLargePlateau = 16;
 
-double secondsSince(std::chrono::steady_clock::time_point start)
-{
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 std::vector<bool> hypothesisOf(const LeafBox& leaf, std::size_t k)
 {

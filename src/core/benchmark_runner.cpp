@@ -1,4 +1,5 @@
 #include "fdml_localization/core/benchmark_runner.h"
+#include "fdml_localization/core/stopwatch.h"
 
 #include <algorithm>
 #include <chrono>
@@ -21,10 +22,6 @@ constexpr double kPaperAgreementTolerance = 2.0;
 constexpr double kNoAgreementFilter = 1e9;
 constexpr int kAllCandidates = 1000000;
 
-double secondsSince(std::chrono::steady_clock::time_point start)
-{
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 std::string joinIssues(const std::string& what, const std::vector<std::string>& issues)
 {

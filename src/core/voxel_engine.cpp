@@ -2,6 +2,7 @@
 
 #include "fdml_localization/core/candidate_refinement.h"
 #include "fdml_localization/core/components.h"
+#include "fdml_localization/core/stopwatch.h"
 
 #include <omp.h>
 #ifdef __SSE2__
@@ -21,10 +22,6 @@ namespace core
 {
 namespace
 {
-double secondsSince(std::chrono::steady_clock::time_point start)
-{
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 /// Where rays hit near a concave corner, h is the minimum of two linear pieces and peaks between
 /// samples, above all of them, by up to about the slope difference times half a cell: the band

@@ -4,6 +4,7 @@
 
 #include "fdml_localization/core/candidate_refinement.h"
 #include "fdml_localization/core/components.h"
+#include "fdml_localization/core/stopwatch.h"
 
 #include <omp.h>
 
@@ -18,10 +19,6 @@ namespace core
 {
 namespace
 {
-double secondsSince(std::chrono::steady_clock::time_point start)
-{
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 /// Seeds of a level (in processing order) that may be retried from other voxels of their plateau.
 constexpr long kRetriedSeeds = 32;

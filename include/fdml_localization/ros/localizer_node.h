@@ -213,4 +213,11 @@ private:
   std::thread worker_;  ///< started last, joined in the destructor
 };
 
+/**
+ * @brief The fdml_localizer node's life: loads and validates the parameters (logging every
+ *        error), loads the map, runs the node until shutdown.
+ * @return the process exit status: 0, 2 for invalid parameters, 1 when the map cannot be loaded
+ */
+int runLocalizerNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh);
+
 }  // namespace fdml_localization

@@ -1,6 +1,6 @@
 # Shared settings for the build, test and demo scripts (sourced, not run).
-# The catkin workspace lives in a git-ignored folder with this repository linked as
-# its src/fdml_localization, so the checkout itself stays the package's source tree.
+# The catkin workspace lives in a git-ignored folder (ws/) whose src/fdml_localization links
+# to this checkout's files, so the checkout itself stays the package's source tree.
 REPO_DIR="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 WS="${WS:-$REPO_DIR/ws}"
 JOBS="${JOBS:-$(nproc)}"
@@ -10,10 +10,19 @@ export ROS_HOME="${ROS_HOME:-$WS/ros_home}"
 export ROS_LOG_DIR="${ROS_LOG_DIR:-$ROS_HOME/log}"
 
 make_workspace() {
-  mkdir -p "$WS/src"
-  if [ ! -e "$WS/src/fdml_localization" ]; then
-    ln -s "$REPO_DIR" "$WS/src/fdml_localization"
-  fi
+  # The package folder holds a link to each top-level entry of this checkout, except the
+  # workspace itself: a link to the whole checkout would contain ws/ again, and roslaunch's
+  # file search (which follows links) would loop through ws/src/fdml_localization/ws/...
+  local pkg="$WS/src/fdml_localization"
+  [ -L "$pkg" ] && rm "$pkg"
+  mkdir -p "$pkg"
+  local ws_real entry
+  ws_real="$(cd "$WS" && pwd -P)"
+  for entry in "$REPO_DIR"/*; do
+    [ "$(cd "$entry" 2>/dev/null && pwd -P)" = "$ws_real" ] && continue
+    ln -sfn "$entry" "$pkg/$(basename "$entry")"
+  done
+  find "$pkg" -maxdepth 1 -xtype l -delete  # entries removed from the checkout
 }
 
 catkin_build() {

@@ -41,8 +41,14 @@ trap stop_launch EXIT
 # Wait for the master roslaunch starts (up to 30 s) before the client registers with it.
 for _ in $(seq 300); do
   rosnode list >/dev/null 2>&1 && break
+  kill -0 "$launch_pid" 2>/dev/null || break
   sleep 0.1
 done
+if ! kill -0 "$launch_pid" 2>/dev/null || ! rosnode list >/dev/null 2>&1; then
+  echo "demo: the simulation did not start; the end of $log:" >&2
+  tail -n 30 "$log" >&2
+  exit 2
+fi
 
 status=0
 /usr/bin/python3 "$REPO_DIR/scripts/demo_client.py" --kidnaps "$KIDNAPS" || status=$?

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
+#include <stdexcept>
 
 namespace fdml_localization
 {
@@ -27,6 +28,21 @@ void check(std::vector<std::string>* errors, bool ok, const char* name, const T&
   std::ostringstream out;
   out << "~" << name << " = " << value << " is out of range; allowed: " << allowed;
   errors->push_back(out.str());
+}
+
+/// True when @p parse (core::parseEngine, core::parseMethod) accepts @p name.
+template <typename Parse>
+bool knownName(const std::string& name, Parse parse)
+{
+  try
+  {
+    parse(name);
+    return true;
+  }
+  catch (const std::invalid_argument&)
+  {
+    return false;
+  }
 }
 
 bool finiteIn(double value, double lo, double hi)
@@ -113,9 +129,9 @@ std::vector<std::string> validate(const Params& p)
   check(&errors, !p.range_topic.empty(), "range_topic", quoted(p.range_topic), "a non-empty topic name");
   check(&errors, !p.scan_topic.empty(), "scan_topic", quoted(p.scan_topic), "a non-empty topic name");
 
-  check(&errors, p.engine == "voxel" || p.engine == "adaptive", "engine", quoted(p.engine),
+  check(&errors, knownName(p.engine, core::parseEngine), "engine", quoted(p.engine),
         "\"voxel\" or \"adaptive\"");
-  check(&errors, p.method == "robust" || p.method == "paper" || p.method == "baseline", "method", quoted(p.method),
+  check(&errors, knownName(p.method, core::parseMethod), "method", quoted(p.method),
         "\"robust\", \"paper\" or \"baseline\"");
   // The voxel engine's table holds n x n x n_theta samples; the adaptive engine goes far finer.
   const int max_resolution = p.engine == "adaptive" ? core::kMaxAdaptiveResolution : core::kMaxVoxelResolution;
@@ -147,18 +163,14 @@ std::vector<std::string> validate(const Params& p)
 core::LocalizerOptions toLocalizerOptions(const Params& p)
 {
   core::LocalizerOptions options;
-  options.engine = p.engine == "adaptive" ? core::Engine::Adaptive : core::Engine::Voxel;
-  if (p.method == "paper")
+  // Unknown names keep the defaults; validate() reports them.
+  if (knownName(p.engine, core::parseEngine))
   {
-    options.method = core::Method::Paper;
+    options.engine = core::parseEngine(p.engine);
   }
-  else if (p.method == "baseline")
+  if (knownName(p.method, core::parseMethod))
   {
-    options.method = core::Method::Baseline;
-  }
-  else
-  {
-    options.method = core::Method::Robust;
+    options.method = core::parseMethod(p.method);
   }
   options.resolution = p.resolution;
   options.theta_resolution = p.theta_resolution;

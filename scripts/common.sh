@@ -39,3 +39,24 @@ source_workspace() {
   source "$WS/devel/setup.bash"
   set -u
 }
+
+# start_simulation PORT LOG [roslaunch args...]: launches simulation.launch with its own master
+# on PORT (output to LOG), stops it when the calling script exits, and waits up to 30 s for the
+# master. Returns non-zero, with the end of LOG on stderr, when the simulation did not start.
+start_simulation() {
+  local port="$1" log="$2"
+  shift 2
+  export ROS_MASTER_URI="http://localhost:$port"
+  export ROS_IP=127.0.0.1
+  roslaunch -p "$port" fdml_localization simulation.launch "$@" >"$log" 2>&1 &
+  SIMULATION_PID=$!
+  trap 'kill -INT "$SIMULATION_PID" 2>/dev/null || true; wait "$SIMULATION_PID" 2>/dev/null || true' EXIT
+  for _ in $(seq 300); do
+    rosnode list >/dev/null 2>&1 && return 0
+    kill -0 "$SIMULATION_PID" 2>/dev/null || break
+    sleep 0.1
+  done
+  echo "the simulation did not start; the end of $log:" >&2
+  tail -n 30 "$log" >&2
+  return 1
+}

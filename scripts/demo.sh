@@ -14,9 +14,6 @@ RVIZ="${RVIZ:-0}"
 KIDNAPS="${KIDNAPS:-5}"
 SCENARIO="${SCENARIO:-demo}"
 MAP="${MAP:-apartment}"
-PORT="${FDML_DEMO_PORT:-11391}"
-export ROS_MASTER_URI="http://localhost:$PORT"
-export ROS_IP=127.0.0.1
 
 rviz_arg=false
 if [ "$RVIZ" = "1" ]; then
@@ -29,26 +26,7 @@ fi
 
 log="$WS/demo_launch.log"
 echo "demo: launching the simulation (scenario $SCENARIO, map $MAP, rviz $rviz_arg); log: $log"
-roslaunch -p "$PORT" fdml_localization simulation.launch rviz:="$rviz_arg" \
-  scenario:="$SCENARIO" map:="$MAP" >"$log" 2>&1 &
-launch_pid=$!
-stop_launch() {
-  kill -INT "$launch_pid" 2>/dev/null || true
-  wait "$launch_pid" 2>/dev/null || true
-}
-trap stop_launch EXIT
-
-# Wait for the master roslaunch starts (up to 30 s) before the client registers with it.
-for _ in $(seq 300); do
-  rosnode list >/dev/null 2>&1 && break
-  kill -0 "$launch_pid" 2>/dev/null || break
-  sleep 0.1
-done
-if ! kill -0 "$launch_pid" 2>/dev/null || ! rosnode list >/dev/null 2>&1; then
-  echo "demo: the simulation did not start; the end of $log:" >&2
-  tail -n 30 "$log" >&2
-  exit 2
-fi
+start_simulation "${FDML_DEMO_PORT:-11391}" "$log" rviz:="$rviz_arg" scenario:="$SCENARIO" map:="$MAP" || exit 2
 
 status=0
 /usr/bin/python3 "$REPO_DIR/scripts/demo_client.py" --kidnaps "$KIDNAPS" || status=$?

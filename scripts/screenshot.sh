@@ -4,14 +4,7 @@
 set -euo pipefail
 source "$(dirname "$0")/common.sh"
 source_workspace
-export ROS_MASTER_URI="http://localhost:${FDML_DEMO_PORT:-11392}"
-roslaunch -p "${FDML_DEMO_PORT:-11392}" fdml_localization simulation.launch rviz:=true >"$WS/screenshot_launch.log" 2>&1 &
-launch_pid=$!
-trap 'kill -INT $launch_pid 2>/dev/null || true; wait $launch_pid 2>/dev/null || true' EXIT
-for _ in $(seq 300); do
-  rosnode list >/dev/null 2>&1 && break
-  sleep 0.1
-done
+start_simulation "${FDML_DEMO_PORT:-11392}" "$WS/screenshot_launch.log" rviz:=true
 /usr/bin/python3 "$REPO_DIR/scripts/demo_client.py" --kidnaps 6 --stop-when-unambiguous
 sleep 3  # let rviz draw the last answer before the picture
 import -window root "$REPO_DIR/docs/rviz_demo.png"

@@ -13,9 +13,21 @@ namespace
 {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+/// The ranking of betterCandidate() on evaluations.
+bool rankedBefore(int inliers_a, int contradicted_a, double rms_a, int inliers_b, int contradicted_b, double rms_b)
+{
+  const int net_a = inliers_a - contradicted_a;
+  const int net_b = inliers_b - contradicted_b;
+  if (net_a != net_b)
+  {
+    return net_a > net_b;
+  }
+  return contradicted_a != contradicted_b ? contradicted_a < contradicted_b : rms_a < rms_b;
+}
+
 bool evaluationBetter(const PoseEvaluation& a, const PoseEvaluation& b)
 {
-  return a.inliers != b.inliers ? a.inliers > b.inliers : a.rms < b.rms;
+  return rankedBefore(a.inliers, a.contradicted, a.rms, b.inliers, b.contradicted, b.rms);
 }
 }  // namespace
 
@@ -79,6 +91,10 @@ PoseEvaluation evaluatePose(const MapRayCaster& map, const Pose2& pose, const st
         sum_sq += r * r;
         ++finite_inliers;
       }
+      else if (r < 0.0)
+      {
+        ++eval.contradicted;
+      }
     }
     else
     {
@@ -87,6 +103,10 @@ PoseEvaluation evaluatePose(const MapRayCaster& map, const Pose2& pose, const st
       {
         eval.inlier_mask[i] = true;
         ++eval.inliers;
+      }
+      else
+      {
+        ++eval.contradicted;
       }
     }
   }
@@ -102,6 +122,7 @@ Candidate verifiedCandidate(const MapRayCaster& map, const Pose2& pose, const st
   c.pose = Pose2(pose.x, pose.y, wrapAngle(pose.theta));
   c.inlier_mask = eval.inlier_mask;
   c.inliers = eval.inliers;
+  c.contradicted = eval.contradicted;
   c.rms_residual = eval.rms;
   return c;
 }
@@ -319,6 +340,7 @@ Candidate refineSeed(const MapRayCaster& map, const Pose2& seed, const std::vect
   c.pose = Pose2(best_pose.x, best_pose.y, wrapAngle(best_pose.theta));
   c.inlier_mask = best.inlier_mask;
   c.inliers = best.inliers;
+  c.contradicted = best.contradicted;
   c.rms_residual = best.rms;
   c.covariance = best_cov;
   return c;
@@ -326,11 +348,7 @@ Candidate refineSeed(const MapRayCaster& map, const Pose2& seed, const std::vect
 
 bool betterCandidate(const Candidate& a, const Candidate& b)
 {
-  if (a.inliers != b.inliers)
-  {
-    return a.inliers > b.inliers;
-  }
-  return a.rms_residual < b.rms_residual;
+  return rankedBefore(a.inliers, a.contradicted, a.rms_residual, b.inliers, b.contradicted, b.rms_residual);
 }
 
 std::vector<Candidate> rankAndDeduplicate(std::vector<Candidate> candidates, double distance, double angle,

@@ -3,6 +3,7 @@
 // components, the table cache, input validation and candidate ranking.
 #include "fdml_localization/core/candidate_refinement.h"
 #include "fdml_localization/core/components.h"
+#include "fdml_localization/core/hypothesis_seeds.h"
 #include "fdml_localization/core/table_cache.h"
 #include "fdml_localization/core/voxel_engine.h"
 
@@ -16,6 +17,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <random>
+#include <set>
 
 namespace fdml_localization
 {
@@ -327,6 +330,105 @@ TEST(Components, EveryCountPeakBecomesItsOwnSeed)
   EXPECT_NEAR(at6[0].centroid.x, spec.centreX(3), 1e-12);
   EXPECT_NEAR(at5[0].centroid.x, spec.centreX(15), 1e-12);
   EXPECT_EQ(componentSize(spec, count, 4, spec.index(3, 2, 3)), 15u);
+}
+
+TEST(HypothesisSeeds, MaximalSetsMatchBruteForce)
+{
+  // Random blobs of 6 readings on a small periodic grid; the kept voxels must be exactly those
+  // no neighbour strictly extends, grouped into connected plateaus of identical membership.
+  const GridSpec spec = smallSpec(12, 10, 8);
+  std::mt19937_64 rng(5);
+  std::vector<VoxelSet> sets(6, VoxelSet(spec));
+  std::uniform_int_distribution<int> ux(0, spec.nx - 1);
+  std::uniform_int_distribution<int> uy(0, spec.ny - 1);
+  std::uniform_int_distribution<int> ut(0, spec.nt - 1);
+  for (VoxelSet& set : sets)
+  {
+    for (int blob = 0; blob < 6; ++blob)
+    {
+      const int cx = ux(rng);
+      const int cy = uy(rng);
+      const int ct = ut(rng);
+      for (int dt = -1; dt <= 1; ++dt)
+      {
+        for (int dy = -2; dy <= 2; ++dy)
+        {
+          for (int dx = -2; dx <= 2; ++dx)
+          {
+            const int x = cx + dx;
+            const int y = cy + dy;
+            if (x >= 0 && x < spec.nx && y >= 0 && y < spec.ny)
+            {
+              set.set(x, y, (ct + dt + spec.nt) % spec.nt);
+            }
+          }
+        }
+      }
+    }
+  }
+  auto maskOf = [&](std::size_t v) {
+    int ix = 0;
+    int iy = 0;
+    int it = 0;
+    spec.unindex(v, ix, iy, it);
+    unsigned mask = 0;
+    for (std::size_t i = 0; i < sets.size(); ++i)
+    {
+      mask |= sets[i].test(ix, iy, it) ? 1u << i : 0u;
+    }
+    return mask;
+  };
+  std::vector<std::uint8_t> count(spec.voxelCount(), 0);
+  for (std::size_t v = 0; v < count.size(); ++v)
+  {
+    count[v] = static_cast<std::uint8_t>(__builtin_popcount(maskOf(v)));
+  }
+  const auto buckets = voxelsByCount(count, 2, 6);
+  int plateaus = 0;
+  for (int level = 2; level <= 6; ++level)
+  {
+    std::set<std::size_t> expected;
+    for (std::size_t v : buckets[level])
+    {
+      int ix = 0;
+      int iy = 0;
+      int it = 0;
+      spec.unindex(v, ix, iy, it);
+      bool dominated = false;
+      forEachNeighbour(spec, ix, iy, it, [&](std::size_t u) {
+        dominated = dominated || ((maskOf(u) & maskOf(v)) == maskOf(v) && maskOf(u) != maskOf(v));
+      });
+      if (!dominated)
+      {
+        expected.insert(v);
+      }
+    }
+    std::set<std::size_t> kept;
+    for (const HypothesisSeed& seed : maximalHypotheses(spec, sets, count, level, buckets[level], 2))
+    {
+      ++plateaus;
+      EXPECT_EQ(seed.plateau.peak_count, level);
+      const unsigned mask = maskOf(seed.plateau.voxels.front());
+      for (std::size_t i = 0; i < sets.size(); ++i)
+      {
+        EXPECT_EQ(seed.hypothesis[i], ((mask >> i) & 1u) == 1u);
+      }
+      for (std::size_t v : seed.plateau.voxels)
+      {
+        EXPECT_EQ(maskOf(v), mask);
+        EXPECT_TRUE(kept.insert(v).second) << "voxel in two plateaus";
+      }
+      // Connected: the plateau is one component of its own voxels.
+      std::vector<std::uint8_t> own(spec.voxelCount(), 0);
+      for (std::size_t v : seed.plateau.voxels)
+      {
+        own[v] = 1;
+      }
+      EXPECT_EQ(connectedComponents(spec, own, 1).size(), 1u);
+    }
+    EXPECT_EQ(kept, expected) << "level " << level;
+  }
+  EXPECT_GT(plateaus, 10);
 }
 
 TEST(TableCache, RoundTripAndEveryKindOfDamageIsRejected)

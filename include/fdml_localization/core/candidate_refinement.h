@@ -24,13 +24,18 @@ struct PoseEvaluation
   std::vector<double> residuals;  ///< h(q (+) g_i) - d_i [m]; NaN for no-return readings or a
                                   ///< sensor outside free space
   int inliers = 0;
+  /// Readings the map contradicts: measured longer than h + eps, or no return where the map has
+  /// a wall within max_range - eps. Unknown obstacles only shorten readings, so none of these
+  /// is explained by one.
+  int contradicted = 0;
   double rms = 0.0;  ///< RMS of the residuals of the finite-range inliers [m]
 };
 
 /**
  * @brief Verifies @p pose: reading i agrees when its sensor position q (+) g_i is in free
  *        space and |h(q (+) g_i) - d_i| < eps, or, for a no-return reading (d_i = +inf),
- *        when h(q (+) g_i) > max_range_i - eps.
+ *        when h(q (+) g_i) > max_range_i - eps. A reading the map contradicts (see
+ *        PoseEvaluation::contradicted) counts against the pose in the ranking.
  * @param eps agreement tolerance [m]
  */
 PoseEvaluation evaluatePose(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings,
@@ -109,7 +114,11 @@ std::vector<double> vertexMargins(const MapRayCaster& map, const Pose2& pose, co
 Candidate verifiedCandidate(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings,
                             double eps);
 
-/// Ranking order: more inliers first, then lower RMS residual.
+/**
+ * @brief Ranking order: the larger net consensus (inliers - contradicted) first, then fewer
+ *        contradicted readings, then lower RMS residual. Without contradicted readings this is
+ *        "most inliers, then lowest RMS".
+ */
 bool betterCandidate(const Candidate& a, const Candidate& b);
 
 /**

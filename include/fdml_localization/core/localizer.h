@@ -104,6 +104,10 @@ struct Candidate
   Pose2 pose;                      ///< robot base pose in the map frame at the first reading
   std::vector<bool> inlier_mask;   ///< per reading: agrees with the static map
   int inliers = 0;
+  /// Readings measured longer than the map allows at this pose (beyond eps), or with no return
+  /// where the map has a wall in range: no unknown obstacle explains them (they only shorten
+  /// readings), so each counts against the pose (ranking: inliers - contradicted first).
+  int contradicted = 0;
   double rms_residual = 0.0;       ///< over the inliers [m]
   double support = 0.0;            ///< voxels (or boxes) of the component it came from
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< of (x, y, theta) from the polish
@@ -124,7 +128,7 @@ struct StageTimes
 /// The outcome of one localize() call.
 struct Result
 {
-  std::vector<Candidate> candidates;  ///< best first: most inliers, then lowest rms
+  std::vector<Candidate> candidates;  ///< best first: see betterCandidate() (candidate_refinement.h)
   int readings_used = 0;
   int min_inliers_used = 0;           ///< k' actually used
   bool truncated = false;             ///< a search budget was reached (adaptive engine)

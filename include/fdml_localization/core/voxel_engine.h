@@ -24,12 +24,15 @@ namespace core
  * @brief The voxel engine. Per call: (1) the preimage of each reading by the sign-change test
  *        on the distance table's 2 x 2 x 2 sample blocks, then a one-voxel dilation (bit-packed
  *        sets); (2) the count field (uint8 per voxel), M_k' = {count >= k'}; (3) seeds.
- *        Robust method: the regional maxima (peak plateaus) of the count field of the dilated
- *        preimages and of the raw ones, level by level from k down, each refined by
- *        refineSeed() (exact ray casts, robust polish); in automatic mode the first level where
- *        a seed explains that many readings is k'; supports are the sizes of the seeds'
- *        components of M_k'. Paper and baseline methods: the circular-mean centres of the
- *        components of M_k' (26-neighbour, periodic theta), the eps filter, delta uniqueness.
+ *        Robust method, level by level from k down: the maximal hypotheses of the raw
+ *        preimages (hypothesis_seeds.h) and the regional maxima of the dilated count field,
+ *        each refined by refineSeed() (exact ray casts, robust polish) once at least level - 2
+ *        readings roughly agree at its centroid; in automatic mode k' is the first level some
+ *        seed reaches net of contradicted readings (betterCandidate()), and the seeds that
+ *        promised one level more get second chances (lattice search, other plateau voxels);
+ *        supports are the sizes of the seeds' components of M_k'. Paper and baseline methods:
+ *        the circular-mean centres of the components of M_k' (26-neighbour, periodic theta),
+ *        the eps filter, delta uniqueness.
  *        Ranking and duplicate removal: rankAndDeduplicate().
  */
 class VoxelEngine : public LocalizerEngine
@@ -76,12 +79,6 @@ public:
   const std::vector<VoxelSet>& lastPreimages() const { return sets_; }
 
 private:
-  struct Seed
-  {
-    std::size_t voxel = 0;
-    Candidate candidate;
-  };
-
   int threads() const;
   void fillPreimageSlice(const Reading& reading, int it, VoxelSet& set) const;
   void localizeRobust(const std::vector<Reading>& readings, Result& result);

@@ -54,7 +54,7 @@ public:
   AdaptiveSearchOptions searchOptions(int min_count) const;
 
 private:
-  /// The robust method: regional maxima per k' from k down, polished seeds (as the voxel engine).
+  /// The robust method: regional maxima per k' from k down, polished seeds, retries.
   void localizeRobust(AdaptiveSearch& search, const std::vector<Reading>& readings, Result& result);
   /// The paper's and the baseline's semantics: one k', verified component centres.
   void localizeFixed(AdaptiveSearch& search, const std::vector<Reading>& readings, int level, Result& result);

@@ -28,13 +28,12 @@ std::vector<HypothesisSeed> maximalHypotheses(const GridSpec& spec, const std::v
                                               const std::vector<std::uint8_t>& count, int level,
                                               const std::vector<std::size_t>& voxels, int threads)
 {
-  const std::vector<std::size_t>& candidates = voxels;
   // A voxel is dominated when a neighbour with a higher count holds all of its readings.
-  std::vector<char> kept(candidates.size(), 0);
+  std::vector<char> kept(voxels.size(), 0);
 #pragma omp parallel for schedule(dynamic, 256) num_threads(threads)
-  for (long c = 0; c < static_cast<long>(candidates.size()); ++c)
+  for (long c = 0; c < static_cast<long>(voxels.size()); ++c)
   {
-    const std::size_t v = candidates[c];
+    const std::size_t v = voxels[c];
     int ix = 0;
     int iy = 0;
     int it = 0;
@@ -56,23 +55,23 @@ std::vector<HypothesisSeed> maximalHypotheses(const GridSpec& spec, const std::v
 
   // Plateaus: kept voxels connected through kept neighbours with the same membership.
   VoxelSet seed_voxels(spec);
-  for (std::size_t c = 0; c < candidates.size(); ++c)
+  for (std::size_t c = 0; c < voxels.size(); ++c)
   {
     if (kept[c])
     {
       int ix = 0;
       int iy = 0;
       int it = 0;
-      spec.unindex(candidates[c], ix, iy, it);
+      spec.unindex(voxels[c], ix, iy, it);
       seed_voxels.set(ix, iy, it);
     }
   }
   VoxelSet visited(spec);
   std::vector<HypothesisSeed> seeds;
   std::vector<std::size_t> stack;
-  for (std::size_t c = 0; c < candidates.size(); ++c)
+  for (std::size_t c = 0; c < voxels.size(); ++c)
   {
-    const std::size_t v = candidates[c];
+    const std::size_t v = voxels[c];
     int ix = 0;
     int iy = 0;
     int it = 0;
@@ -104,7 +103,7 @@ std::vector<HypothesisSeed> maximalHypotheses(const GridSpec& spec, const std::v
         int uy = 0;
         int ut = 0;
         spec.unindex(u, ux, uy, ut);
-        if (count[u] != level || !seed_voxels.test(ux, uy, ut) || visited.test(ux, uy, ut) ||
+        if (!seed_voxels.test(ux, uy, ut) || visited.test(ux, uy, ut) ||
             !membershipWithin(sets, ix, iy, it, ux, uy, ut))
         {
           return;

@@ -150,8 +150,6 @@ struct SeedPool
   }
 
 private:
-  static int netConsensus(const Candidate& c) { return c.inliers - c.contradicted; }
-
   static RefinementSettings levelSettings(int level, const SearchContext& ctx)
   {
     RefinementSettings with = ctx.settings;
@@ -272,7 +270,7 @@ void VoxelEngine::localizeRobust(const std::vector<Reading>& readings, Result& r
       // lower levels' seeds (which promise fewer) cannot enter the ranked list.
       std::vector<Candidate> strong;
       std::copy_if(pool.candidates.begin(), pool.candidates.end(), std::back_inserter(strong),
-                   [&](const Candidate& c) { return c.inliers - c.contradicted >= level; });
+                   [&](const Candidate& c) { return netConsensus(c) >= level; });
       const std::vector<Candidate> ranked = rankAndDeduplicate(
           std::move(strong), options_.uniqueness_distance, options_.uniqueness_angle, options_.max_candidates);
       reached = static_cast<int>(ranked.size()) >= options_.max_candidates;

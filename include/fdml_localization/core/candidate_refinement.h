@@ -114,6 +114,12 @@ std::vector<double> vertexMargins(const MapRayCaster& map, const Pose2& pose, co
 Candidate verifiedCandidate(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings,
                             double eps);
 
+/// Net consensus of a candidate: inliers minus the readings the map contradicts at its pose.
+inline int netConsensus(const Candidate& c)
+{
+  return c.inliers - c.contradicted;
+}
+
 /**
  * @brief Ranking order: the larger net consensus (inliers - contradicted) first, then fewer
  *        contradicted readings, then lower RMS residual. Without contradicted readings this is

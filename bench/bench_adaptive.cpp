@@ -17,11 +17,11 @@
 // Counters: median_ms (median total per call), success (fraction of calls whose best candidate
 // is within 1 cm and 0.1 degree of the truth), resolution, peak_rss_mb (process peak: run one
 // benchmark per process for a clean figure).
-#include "fdml_localization/core/localizer.h"
-#include "fdml_localization/core/map_generators.h"
-#include "fdml_localization/core/map_io.h"
-#include "fdml_localization/core/scene.h"
-#include "fdml_localization/core/voxel_engine.h"
+#include "fdml_localization/core/localization/localizer.h"
+#include "fdml_localization/simulation/map_generators.h"
+#include "fdml_localization/core/map/map_io.h"
+#include "fdml_localization/simulation/scene.h"
+#include "fdml_localization/core/localization/voxel/voxel_engine.h"
 
 #include "bench_utils.h"
 
@@ -91,8 +91,7 @@ std::vector<Batch> protocolBatches(const core::MapRayCaster& map, int count, boo
 {
   std::mt19937_64 rng(7);
   const core::Box2& b = map.map().bounds();
-  std::uniform_real_distribution<double> ux(b.min.x(), b.max.x()), uy(b.min.y(), b.max.y()),
-      ut(-core::kPi, core::kPi);
+  std::uniform_real_distribution<double> ux(b.min.x(), b.max.x()), uy(b.min.y(), b.max.y()), ut(-core::kPi, core::kPi);
   auto freePoint = [&]() {
     for (;;)
     {
@@ -152,7 +151,8 @@ void runEngine(benchmark::State& state, const std::string& entry, core::Engine e
 {
   const auto map = makeMap(entry);
   const core::Vec2 size = map->map().bounds().size();
-  const int cells = std::max(64, static_cast<int>(std::ceil(std::max(size.x(), size.y()) / envDouble("FDML_BENCH_LEAF", 0.1))));
+  const int cells =
+      std::max(64, static_cast<int>(std::ceil(std::max(size.x(), size.y()) / envDouble("FDML_BENCH_LEAF", 0.1))));
   core::LocalizerOptions options;
   options.engine = engine;
   if (engine == core::Engine::Voxel)
@@ -171,7 +171,8 @@ void runEngine(benchmark::State& state, const std::string& entry, core::Engine e
   if (engine == core::Engine::Voxel)
   {
     state.counters["table_mb"] =
-        static_cast<double>(dynamic_cast<core::VoxelEngine&>(localizer.engine()).table().memoryBytes()) / (1024.0 * 1024.0);
+        static_cast<double>(dynamic_cast<core::VoxelEngine&>(localizer.engine()).table().memoryBytes()) /
+        (1024.0 * 1024.0);
   }
   const std::vector<Batch> batches = protocolBatches(*map, 16, outliers);
   std::vector<double> totals;
@@ -220,8 +221,8 @@ int registerAll()
       {
         const std::string name = std::string(outliers ? "Engines4of10/" : "Engines/") +
                                  (engine == core::Engine::Voxel ? "Voxel/" : "Adaptive/") + displayName(entry);
-        benchmark::RegisterBenchmark(name.c_str(),
-                                     [entry, engine, outliers](benchmark::State& s) { runEngine(s, entry, engine, outliers); })
+        benchmark::RegisterBenchmark(
+            name.c_str(), [entry, engine, outliers](benchmark::State& s) { runEngine(s, entry, engine, outliers); })
             ->Iterations(16)
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();

@@ -9,9 +9,9 @@
 //                                    0.1 m; k' = 6), with each stage's mean time as a counter [ms]
 //   Localizer/Localize_auto/<map>/<n> the same with automatic k' (maximum consensus)
 // Each benchmark also reports the process's peak resident memory so far (peak_rss_mb).
-#include "fdml_localization/core/map_io.h"
-#include "fdml_localization/core/scene.h"
-#include "fdml_localization/core/voxel_engine.h"
+#include "fdml_localization/core/map/map_io.h"
+#include "fdml_localization/simulation/scene.h"
+#include "fdml_localization/core/localization/voxel/voxel_engine.h"
 
 #include "bench_utils.h"
 

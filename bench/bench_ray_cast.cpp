@@ -2,9 +2,9 @@
 // office and warehouse maps (and a large generated building), on 1 and 2 threads.
 // Each iteration casts a fixed batch of rays from random free points in an OpenMP loop;
 // items_per_second is rays per second (wall-clock).
-#include "fdml_localization/core/map_generators.h"
-#include "fdml_localization/core/map_io.h"
-#include "fdml_localization/core/ray_caster.h"
+#include "fdml_localization/simulation/map_generators.h"
+#include "fdml_localization/core/map/map_io.h"
+#include "fdml_localization/core/geometry/ray_caster.h"
 
 #include <benchmark/benchmark.h>
 #include <omp.h>
@@ -46,8 +46,7 @@ RayBatch makeBatch(const core::MapRayCaster& caster, std::uint64_t seed)
   return batch;
 }
 
-void castBatch(benchmark::State& state, std::shared_ptr<const core::MapRayCaster> caster, bool accelerated,
-               int threads)
+void castBatch(benchmark::State& state, std::shared_ptr<const core::MapRayCaster> caster, bool accelerated, int threads)
 {
   const RayBatch batch = makeBatch(*caster, 1234);
   const core::SegmentGrid& grid = caster->grid();
@@ -57,8 +56,8 @@ void castBatch(benchmark::State& state, std::shared_ptr<const core::MapRayCaster
 #pragma omp parallel for num_threads(threads) reduction(+ : sum) schedule(static)
     for (int i = 0; i < kBatch; ++i)
     {
-      const core::RayHit hit = accelerated ? grid.cast(batch.origins[i], batch.dirs[i])
-                                           : grid.castBruteForce(batch.origins[i], batch.dirs[i]);
+      const core::RayHit hit = accelerated ? grid.cast(batch.origins[i], batch.dirs[i]) :
+                                             grid.castBruteForce(batch.origins[i], batch.dirs[i]);
       sum += hit.distance;
     }
     benchmark::DoNotOptimize(sum);

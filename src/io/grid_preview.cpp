@@ -13,8 +13,8 @@ namespace io
 {
 using core::OccupancyGrid;
 using core::PolygonMap;
-using core::Vec2;
 using core::Ring;
+using core::Vec2;
 
 namespace
 {
@@ -59,10 +59,10 @@ Rgb cellColour(std::int8_t v)
 {
   if (v < 0 || v > 100)
   {
-    return {160, 160, 160};
+    return { 160, 160, 160 };
   }
   const auto g = static_cast<std::uint8_t>(255 - (v * 215) / 100);  // 0 -> white, 100 -> dark
-  return {g, g, g};
+  return { g, g, g };
 }
 }  // namespace
 
@@ -100,7 +100,7 @@ void writePreviewPng(const std::string& path, const OccupancyGrid& grid, const P
   for (std::size_t r = 0; r < map.rings().size(); ++r)
   {
     const Ring& ring = map.rings()[r];
-    const Rgb colour = r == 0 ? Rgb{0, 90, 255} : Rgb{230, 30, 30};
+    const Rgb colour = r == 0 ? Rgb{ 0, 90, 255 } : Rgb{ 230, 30, 30 };
     for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++)
     {
       canvas.line(toPixel(ring[j]), toPixel(ring[i]), colour);

@@ -1,7 +1,7 @@
 #include "fdml_localization/io/map_files.h"
 
-#include "fdml_localization/core/grid_to_polygon.h"
-#include "fdml_localization/core/map_io.h"
+#include "fdml_localization/core/map/grid/grid_to_polygon.h"
+#include "fdml_localization/core/map/map_io.h"
 
 #include <stb/stb_image.h>
 #include <yaml-cpp/yaml.h>
@@ -21,15 +21,15 @@ namespace io
 {
 using core::GridConversionOptions;
 using core::GridConversionReport;
+using core::gridToPolygon;
+using core::loadPolyFile;
 using core::MapError;
 using core::MapYaml;
 using core::OccupancyGrid;
-using core::PolygonMap;
-using core::Pose2;
-using core::gridToPolygon;
-using core::loadPolyFile;
 using core::parseMapMode;
 using core::pixelsToGrid;
+using core::PolygonMap;
+using core::Pose2;
 
 namespace
 {
@@ -44,8 +44,10 @@ YAML::Node requireKey(const YAML::Node& root, const std::string& key, const std:
   const YAML::Node node = root[key];
   if (!node || node.IsNull())
   {
-    throw MapError(path, 0, "missing key '" + key + "' (map_server YAML needs image, resolution, origin, "
-                            "occupied_thresh, free_thresh and negate)");
+    throw MapError(path, 0,
+                   "missing key '" + key +
+                       "' (map_server YAML needs image, resolution, origin, "
+                       "occupied_thresh, free_thresh and negate)");
   }
   return node;
 }
@@ -75,8 +77,7 @@ bool readFlag(const YAML::Node& node, const std::string& key, const std::string&
     return node.as<int>() != 0;
   }
   catch (const YAML::Exception&)
-  {
-  }
+  {}
   try
   {
     return node.as<bool>();
@@ -118,9 +119,8 @@ MapYaml loadMapYamlFile(const std::string& path)
   }
   meta.image = image.Scalar();
   const std::filesystem::path image_path(meta.image);
-  meta.image_path = image_path.is_absolute()
-                        ? image_path.string()
-                        : (std::filesystem::path(path).parent_path() / image_path).string();
+  meta.image_path = image_path.is_absolute() ? image_path.string() :
+                                               (std::filesystem::path(path).parent_path() / image_path).string();
 
   const YAML::Node resolution = requireKey(root, "resolution", path);
   meta.resolution = readNumber(resolution, "resolution", path);
@@ -176,7 +176,7 @@ OccupancyGrid loadOccupancyGridYaml(const std::string& yaml_path)
   int height = 0;
   int channels = 0;
   std::unique_ptr<stbi_uc, void (*)(void*)> pixels(stbi_load(meta.image_path.c_str(), &width, &height, &channels, 0),
-                                                  stbi_image_free);
+                                                   stbi_image_free);
   if (!pixels)
   {
     const char* why = stbi_failure_reason();
@@ -275,8 +275,9 @@ PolygonMap loadMapFile(const std::string& path, const GridConversionOptions& opt
   {
     return gridToPolygon(loadOccupancyGridYaml(path), options, path, report);
   }
-  throw MapError(path, 0, "unknown map file type '" + ext +
-                              "' (allowed: .poly polygon files, .yaml/.yml map_server occupancy grids)");
+  throw MapError(path, 0,
+                 "unknown map file type '" + ext +
+                     "' (allowed: .poly polygon files, .yaml/.yml map_server occupancy grids)");
 }
 
 }  // namespace io

@@ -116,9 +116,8 @@ visualization_msgs::MarkerArray mapMarkers(const core::PolygonMap& map, const st
   return array;
 }
 
-visualization_msgs::MarkerArray obstacleMarkers(const std::vector<core::Obstacle>& obstacles,
-                                                const std::string& frame, const ros::Time& stamp,
-                                                std::size_t previous_count)
+visualization_msgs::MarkerArray obstacleMarkers(const std::vector<core::Obstacle>& obstacles, const std::string& frame,
+                                                const ros::Time& stamp, std::size_t previous_count)
 {
   visualization_msgs::MarkerArray array;
   for (std::size_t i = 0; i < std::max(obstacles.size(), previous_count); ++i)
@@ -161,8 +160,8 @@ visualization_msgs::MarkerArray obstacleMarkers(const std::vector<core::Obstacle
   return array;
 }
 
-nav_msgs::OccupancyGrid toOccupancyGrid(const core::MapRayCaster& caster, double resolution,
-                                        const std::string& frame, const ros::Time& stamp)
+nav_msgs::OccupancyGrid toOccupancyGrid(const core::MapRayCaster& caster, double resolution, const std::string& frame,
+                                        const ros::Time& stamp)
 {
   if (!(resolution > 0.0))
   {
@@ -214,8 +213,8 @@ core::OccupancyGrid fromOccupancyGridMsg(const nav_msgs::OccupancyGrid& msg)
   grid.width = static_cast<int>(std::min<std::uint32_t>(msg.info.width, std::numeric_limits<int>::max()));
   grid.height = static_cast<int>(std::min<std::uint32_t>(msg.info.height, std::numeric_limits<int>::max()));
   grid.resolution = msg.info.resolution;
-  grid.origin = core::Pose2(msg.info.origin.position.x, msg.info.origin.position.y,
-                            quaternionToYaw(msg.info.origin.orientation));
+  grid.origin =
+      core::Pose2(msg.info.origin.position.x, msg.info.origin.position.y, quaternionToYaw(msg.info.origin.orientation));
   grid.cells.assign(msg.data.begin(), msg.data.end());
   return grid;
 }
@@ -320,9 +319,12 @@ fdml_localization::LocalizationResult toResultMsg(const core::Result& result)
   msg.method = core::toString(result.method);
   msg.solve_time = result.times.total;
   const std::pair<const char*, double> stages[] = {
-    { "table", result.times.table },           { "preimages", result.times.preimages },
-    { "count", result.times.count },           { "components", result.times.components },
-    { "verification", result.times.verification }, { "polish", result.times.polish },
+    { "table", result.times.table },
+    { "preimages", result.times.preimages },
+    { "count", result.times.count },
+    { "components", result.times.components },
+    { "verification", result.times.verification },
+    { "polish", result.times.polish },
   };
   for (const auto& stage : stages)
   {
@@ -463,9 +465,10 @@ visualization_msgs::MarkerArray readingMarkers(const std::vector<core::Reading>&
   {
     const core::Pose2 sensor = core::compose(pose, readings[i].offset);
     const bool no_return = !std::isfinite(readings[i].range);
-    const double length =
-        no_return ? std::min(no_return_length, std::isfinite(readings[i].max_range) ? readings[i].max_range : no_return_length)
-                  : readings[i].range;
+    const double length = no_return ?
+                              std::min(no_return_length, std::isfinite(readings[i].max_range) ? readings[i].max_range :
+                                                                                                no_return_length) :
+                              readings[i].range;
     const core::Vec2 end = sensor.position() + length * sensor.heading();
     const bool inlier = i >= inlier_mask.size() || inlier_mask[i];
     const std_msgs::ColorRGBA c =

@@ -58,8 +58,8 @@ LocalizerNode::LocalizerNode(const ros::NodeHandle& nh, const ros::NodeHandle& p
   process_timer_ = nh_.createWallTimer(ros::WallDuration(0.02), &LocalizerNode::processTimer, this);
   if (params_.publish_tf)
   {
-    tf_timer_ = nh_.createWallTimer(ros::WallDuration(1.0 / params_.tf_publish_rate), &LocalizerNode::publishMapToOdom,
-                                    this);
+    tf_timer_ =
+        nh_.createWallTimer(ros::WallDuration(1.0 / params_.tf_publish_rate), &LocalizerNode::publishMapToOdom, this);
   }
 
   relocalize_srv_ = service_nh_.advertiseService("relocalize", &LocalizerNode::relocalizeService, this);
@@ -250,8 +250,7 @@ void LocalizerNode::startRelocalizationLocked(const OutcomePromise& waiter)
   if (queued_batch_)
   {
     // A batch formed before the request is stale: its waiters move on to the fresh batch.
-    relocalize_waiters_.insert(relocalize_waiters_.end(), queued_batch_->waiters.begin(),
-                               queued_batch_->waiters.end());
+    relocalize_waiters_.insert(relocalize_waiters_.end(), queued_batch_->waiters.begin(), queued_batch_->waiters.end());
     queued_batch_.reset();
   }
   if (waiter)
@@ -268,8 +267,7 @@ void LocalizerNode::startRelocalizationLocked(const OutcomePromise& waiter)
 bool LocalizerNode::relocalizeService(fdml_localization::Relocalize::Request& req,
                                       fdml_localization::Relocalize::Response& res)
 {
-  const double timeout =
-      req.timeout > 0.0 && std::isfinite(req.timeout) ? req.timeout : params_.relocalize_timeout;
+  const double timeout = req.timeout > 0.0 && std::isfinite(req.timeout) ? req.timeout : params_.relocalize_timeout;
   auto waiter = std::make_shared<std::promise<Outcome>>();
   std::future<Outcome> future = waiter->get_future();
   {
@@ -379,9 +377,8 @@ void LocalizerNode::workerLoop()
     nav_msgs::OccupancyGrid::ConstPtr map;
     {
       std::unique_lock<std::mutex> lock(mutex_);
-      work_ready_.wait(lock, [this] {
-        return shutting_down_ || pending_map_ || queued_batch_ || !queued_requests_.empty();
-      });
+      work_ready_.wait(lock,
+                       [this] { return shutting_down_ || pending_map_ || queued_batch_ || !queued_requests_.empty(); });
       if (shutting_down_)
       {
         return;

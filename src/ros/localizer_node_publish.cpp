@@ -127,9 +127,8 @@ LocalizerNode::Outcome LocalizerNode::solve(const Job& job)
     publishBatchOutcome(job, result, outcome);
   }
   // Continuous mode solves many batches a second: its per-batch line is a debug message.
-  const ros::console::levels::Level level = job.from_sensors && mode_ == SolveMode::Continuous
-                                                ? ros::console::levels::Debug
-                                                : ros::console::levels::Info;
+  const ros::console::levels::Level level =
+      job.from_sensors && mode_ == SolveMode::Continuous ? ros::console::levels::Debug : ros::console::levels::Info;
   ROS_LOG(level, ROSCONSOLE_DEFAULT_NAME, "fdml_localizer: %s: %s (%.3f s)", job.from_sensors ? "batch" : "~localize",
           outcome.message.c_str(), result.times.total);
   return outcome;
@@ -217,7 +216,8 @@ void LocalizerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status
   std::lock_guard<std::mutex> lock(mutex_);
   if (!have_map_)
   {
-    status.summary(maps_rejected_ > 0 ? diagnostic_msgs::DiagnosticStatus::ERROR : diagnostic_msgs::DiagnosticStatus::WARN,
+    status.summary(maps_rejected_ > 0 ? diagnostic_msgs::DiagnosticStatus::ERROR :
+                                        diagnostic_msgs::DiagnosticStatus::WARN,
                    maps_rejected_ > 0 ? "no usable map: " + last_map_error_ : std::string("no map yet"));
   }
   else if (last_candidates_ < 0)

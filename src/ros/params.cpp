@@ -88,9 +88,10 @@ std::vector<std::string> validate(const Params& p)
         "0 (one cell) or (0, 10] m");
   check(&errors, !std::isnan(p.map_min_area) && p.map_min_area <= 1e6, "map_min_area", p.map_min_area,
         "< 0 (ten cells' area) or [0, 1e6] m^2");
-  const bool seed_ok = !p.map_seed_point_malformed &&
-                       (p.map_seed_point.empty() || (p.map_seed_point.size() == 2 && std::isfinite(p.map_seed_point[0]) &&
-                                                     std::isfinite(p.map_seed_point[1])));
+  const bool seed_ok =
+      !p.map_seed_point_malformed &&
+      (p.map_seed_point.empty() ||
+       (p.map_seed_point.size() == 2 && std::isfinite(p.map_seed_point[0]) && std::isfinite(p.map_seed_point[1])));
   if (!seed_ok)
   {
     std::ostringstream out;
@@ -112,12 +113,10 @@ std::vector<std::string> validate(const Params& p)
   check(&errors, parseSolveMode(p.mode, &mode), "mode", quoted(p.mode), "\"on_request\" or \"continuous\"");
   check(&errors, p.beams_per_scan >= 1 && p.beams_per_scan <= 1000, "beams_per_scan", p.beams_per_scan,
         "an integer in [1, 1000]");
-  check(&errors, finiteIn(p.transform_tolerance, 0.0, 10.0), "transform_tolerance", p.transform_tolerance,
-        "[0, 10] s");
+  check(&errors, finiteIn(p.transform_tolerance, 0.0, 10.0), "transform_tolerance", p.transform_tolerance, "[0, 10] s");
   check(&errors, finiteIn(p.relocalize_timeout, 1e-3, 3600.0), "relocalize_timeout", p.relocalize_timeout,
         "(0, 3600] s");
-  check(&errors, finiteIn(p.tf_publish_rate, 1e-3, 1000.0), "tf_publish_rate", p.tf_publish_rate,
-        "(0, 1000] Hz");
+  check(&errors, finiteIn(p.tf_publish_rate, 1e-3, 1000.0), "tf_publish_rate", p.tf_publish_rate, "(0, 1000] Hz");
   check(&errors, validFrame(p.global_frame_id), "global_frame_id", quoted(p.global_frame_id),
         "a non-empty frame id without spaces");
   check(&errors, validFrame(p.odom_frame_id), "odom_frame_id", quoted(p.odom_frame_id),
@@ -129,8 +128,7 @@ std::vector<std::string> validate(const Params& p)
   check(&errors, !p.range_topic.empty(), "range_topic", quoted(p.range_topic), "a non-empty topic name");
   check(&errors, !p.scan_topic.empty(), "scan_topic", quoted(p.scan_topic), "a non-empty topic name");
 
-  check(&errors, knownName(p.engine, core::parseEngine), "engine", quoted(p.engine),
-        "\"voxel\" or \"adaptive\"");
+  check(&errors, knownName(p.engine, core::parseEngine), "engine", quoted(p.engine), "\"voxel\" or \"adaptive\"");
   check(&errors, knownName(p.method, core::parseMethod), "method", quoted(p.method),
         "\"robust\", \"paper\" or \"baseline\"");
   // The voxel engine's table holds n x n x n_theta samples; the adaptive engine goes far finer.
@@ -153,8 +151,7 @@ std::vector<std::string> validate(const Params& p)
   check(&errors, finiteIn(p.range_tolerance, 0.0, 10.0), "range_tolerance", p.range_tolerance, "[0, 10] m");
   check(&errors, p.max_candidates >= 1 && p.max_candidates <= 10000, "max_candidates", p.max_candidates,
         "an integer in [1, 10000]");
-  check(&errors, p.threads >= 0 && p.threads <= 1024, "threads", p.threads,
-        "0 (all cores) or an integer in [1, 1024]");
+  check(&errors, p.threads >= 0 && p.threads <= 1024, "threads", p.threads, "0 (all cores) or an integer in [1, 1024]");
   check(&errors, p.max_boxes >= 1000, "max_boxes", p.max_boxes, "an integer >= 1000");
   check(&errors, finiteIn(p.deadline, 0.0, 3600.0), "deadline", p.deadline, "0 (none) or (0, 3600] s");
   return errors;
@@ -254,11 +251,11 @@ std::string describe(const Params& p)
   out << "fdml_localizer configuration:\n"
       << "  map_file: " << (p.map_file.empty() ? "(none)" : p.map_file)
       << ", use_map_topic: " << (p.use_map_topic ? "true" : "false") << "\n"
-      << "  grid maps: map_simplify_tolerance: " << p.map_simplify_tolerance << " m (0 = one cell), map_min_area: "
-      << p.map_min_area << " m^2 (< 0 = ten cells), map_seed_point: "
-      << (p.map_seed_point.size() == 2
-              ? "[" + std::to_string(p.map_seed_point[0]) + ", " + std::to_string(p.map_seed_point[1]) + "]"
-              : std::string("(largest free region)"))
+      << "  grid maps: map_simplify_tolerance: " << p.map_simplify_tolerance
+      << " m (0 = one cell), map_min_area: " << p.map_min_area << " m^2 (< 0 = ten cells), map_seed_point: "
+      << (p.map_seed_point.size() == 2 ?
+              "[" + std::to_string(p.map_seed_point[0]) + ", " + std::to_string(p.map_seed_point[1]) + "]" :
+              std::string("(largest free region)"))
       << ", map_occupied_threshold: " << p.map_occupied_threshold << "\n"
       << "  measurements_per_batch: " << p.measurements_per_batch << ", batch_stride: " << p.batch_stride
       << ", mode: " << p.mode << ", beams_per_scan: " << p.beams_per_scan << "\n"
@@ -269,10 +266,9 @@ std::string describe(const Params& p)
       << "  topics: range " << p.range_topic << ", scan " << p.scan_topic << "\n"
       << "  engine: " << p.engine << ", method: " << p.method << ", resolution: " << p.resolution
       << ", theta_resolution: " << p.theta_resolution << ", min_inliers: " << p.min_inliers << "\n"
-      << "  agreement_tolerance: " << p.agreement_tolerance
-      << " m" << (p.agreement_tolerance_set ? "" : " (default)") << ", uniqueness_distance: " << p.uniqueness_distance
-      << " m, uniqueness_angle: " << p.uniqueness_angle << " rad, range_tolerance: " << p.range_tolerance << " m"
-      << (p.range_tolerance_set ? "" : " (default)") << "\n"
+      << "  agreement_tolerance: " << p.agreement_tolerance << " m" << (p.agreement_tolerance_set ? "" : " (default)")
+      << ", uniqueness_distance: " << p.uniqueness_distance << " m, uniqueness_angle: " << p.uniqueness_angle
+      << " rad, range_tolerance: " << p.range_tolerance << " m" << (p.range_tolerance_set ? "" : " (default)") << "\n"
       << "  max_candidates: " << p.max_candidates << ", threads: " << p.threads << ", max_boxes: " << p.max_boxes
       << ", deadline: " << p.deadline << " s\n"
       << "  cache_dir: " << (p.cache_dir.empty() ? "(none)" : p.cache_dir);

@@ -1,7 +1,7 @@
 #include "fdml_localization/ros/simulator_node.h"
 
 #include "fdml_localization/ReadingTruth.h"
-#include "fdml_localization/core/map_io.h"
+#include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/ros/conversions.h"
 #include "fdml_localization/ros/param_utils.h"
 
@@ -51,8 +51,7 @@ nav_msgs::Odometry odometryMsg(const core::Pose2& pose, double linear, double an
 }  // namespace
 
 SimulatorNode::SimulatorNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh) : nh_(nh), pnh_(pnh)
-{
-}
+{}
 
 bool SimulatorNode::init(std::vector<std::string>* errors)
 {
@@ -136,8 +135,8 @@ bool SimulatorNode::init(std::vector<std::string>* errors)
 
   const double period = std::max(kMinTimerPeriod, sim_->stepSize() / config_.time_scale);
   timer_ = nh_.createWallTimer(ros::WallDuration(period), &SimulatorNode::onTimer, this);
-  ROS_INFO("fdml_simulator: scenario '%s', map %s, %zu sensors, %zu obstacles, %s time x%.3g",
-           config_.name.c_str(), map_path_.c_str(), config_.sensors.size(), sim_->scene().obstacles().size(),
+  ROS_INFO("fdml_simulator: scenario '%s', map %s, %zu sensors, %zu obstacles, %s time x%.3g", config_.name.c_str(),
+           map_path_.c_str(), config_.sensors.size(), sim_->scene().obstacles().size(),
            config_.publish_clock ? "simulated (/clock)" : "wall", config_.publish_clock ? config_.time_scale : 1.0);
   return true;
 }
@@ -253,8 +252,7 @@ void SimulatorNode::publishScan(const core::SimScan& scan, const ros::Time& stam
 void SimulatorNode::publishMarkers(const ros::Time& stamp)
 {
   const std::string& frame = config_.frames.map;
-  visualization_msgs::MarkerArray obstacles =
-      obstacleMarkers(sim_->scene().obstacles(), frame, stamp, marker_count_);
+  visualization_msgs::MarkerArray obstacles = obstacleMarkers(sim_->scene().obstacles(), frame, stamp, marker_count_);
   marker_count_ = sim_->scene().obstacles().size();
   visualization_msgs::Marker robot;
   robot.header.frame_id = frame;
@@ -286,8 +284,8 @@ void SimulatorNode::publishMarkers(const ros::Time& stamp)
       continue;
     }
     const double length = std::isfinite(r.true_range) ? r.true_range : config_.sensors[i].max_range;
-    const std_msgs::ColorRGBA color = r.dropped ? makeColor(0.6f, 0.6f, 0.6f, 0.5f) :
-                                      r.kind == core::SceneHit::Kind::Map ? makeColor(0.1f, 0.8f, 0.2f) :
+    const std_msgs::ColorRGBA color = r.dropped                                ? makeColor(0.6f, 0.6f, 0.6f, 0.5f) :
+                                      r.kind == core::SceneHit::Kind::Map      ? makeColor(0.1f, 0.8f, 0.2f) :
                                       r.kind == core::SceneHit::Kind::Obstacle ? makeColor(0.9f, 0.1f, 0.1f) :
                                                                                  makeColor(0.6f, 0.6f, 0.6f);
     rays.points.push_back(toPointMsg(r.sensor_pose.position(), 0.05));
@@ -342,8 +340,8 @@ void SimulatorNode::onCmdVel(const geometry_msgs::Twist::ConstPtr& msg)
 bool SimulatorNode::onKidnap(Kidnap::Request& request, Kidnap::Response& response)
 {
   core::Pose2 pose = fromPose2D(request.pose);
-  response.success = request.random ? sim_->kidnapRandom(&pose, &response.message) :
-                                      sim_->kidnap(pose, &response.message);
+  response.success =
+      request.random ? sim_->kidnapRandom(&pose, &response.message) : sim_->kidnap(pose, &response.message);
   response.pose = toPose2D(sim_->truePose());
   if (response.success)
   {

@@ -1,9 +1,9 @@
 // fdml_bench: the paper's benchmark protocol (method.md section 5) on any maps. Prints the
 // paper-style table on stdout, progress on stderr, one CSV row per trial with --csv.
-#include "fdml_localization/core/benchmark_runner.h"
-#include "fdml_localization/core/text_parsing.h"
-#include "fdml_localization/core/map_generators.h"
-#include "fdml_localization/core/map_io.h"
+#include "fdml_localization/benchmark/benchmark_runner.h"
+#include "fdml_localization/core/util/text_parsing.h"
+#include "fdml_localization/simulation/map_generators.h"
+#include "fdml_localization/core/map/map_io.h"
 
 #include <cmath>
 #include <cstdio>
@@ -24,22 +24,20 @@ namespace core = fdml_localization::core;
 /// the standard deviation (0.2) of the public prototype's Gaussian radii.
 constexpr double kRandomRadiusNoise = 0.35;
 
-const char* kUsage =
-    "usage: fdml_bench --map PATH[:SCALE] [--map ...] [--random VERTICES[:SCALE]]\n"
-    "                  --obstacles 10,30 [--radius 0.1] [--k 10] [--min-inliers 6|auto]\n"
-    "                  --resolution 50,100,150,200 --trials 50 [--seed 1]\n"
-    "                  [--method robust|paper|baseline[,...]] [--engine voxel|adaptive] [--threads J]\n"
-    "                  [--moving-obstacles] [--translate] [--noise SIGMA]\n"
-    "                  [--csv FILE] [--markdown FILE]\n"
-    "Scene names: the map file's stem, random<VERTICES> for --random; a SCALE other than 1\n"
-    "appends _x<SCALE> (checkpoint.poly:0.25 -> checkpoint_x0.25, --random 70:2 -> random70_x2).\n";
+const char* kUsage = "usage: fdml_bench --map PATH[:SCALE] [--map ...] [--random VERTICES[:SCALE]]\n"
+                     "                  --obstacles 10,30 [--radius 0.1] [--k 10] [--min-inliers 6|auto]\n"
+                     "                  --resolution 50,100,150,200 --trials 50 [--seed 1]\n"
+                     "                  [--method robust|paper|baseline[,...]] [--engine voxel|adaptive] [--threads "
+                     "J]\n"
+                     "                  [--moving-obstacles] [--translate] [--noise SIGMA]\n"
+                     "                  [--csv FILE] [--markdown FILE]\n"
+                     "Scene names: the map file's stem, random<VERTICES> for --random; a SCALE other than 1\n"
+                     "appends _x<SCALE> (checkpoint.poly:0.25 -> checkpoint_x0.25, --random 70:2 -> random70_x2).\n";
 
 struct UsageError : std::runtime_error
 {
   using std::runtime_error::runtime_error;
 };
-
-
 
 std::vector<std::string> splitList(const std::string& text)
 {

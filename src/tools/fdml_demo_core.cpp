@@ -1,7 +1,7 @@
 // Interim demo of the core library: loads a map, takes k range readings from a random free
 // pose (turning in place), and prints them next to the exact ray casts.
-#include "fdml_localization/core/map_io.h"
-#include "fdml_localization/core/ray_caster.h"
+#include "fdml_localization/core/map/map_io.h"
+#include "fdml_localization/core/geometry/ray_caster.h"
 
 #include <cstdio>
 #include <exception>

@@ -8,9 +8,9 @@
 // READINGS.csv: header "gx,gy,gtheta,d" (optionally ",max_range"), one reading per line
 // [m, rad]; d may be "inf" (no return within max_range). Prints "rank,x,y,theta,inliers,rms"
 // and one candidate per line, best first; exit 0 (also with no candidate), 2 on bad input.
-#include "fdml_localization/core/localizer.h"
-#include "fdml_localization/core/map_io.h"
-#include "fdml_localization/core/text_parsing.h"
+#include "fdml_localization/core/localization/localizer.h"
+#include "fdml_localization/core/map/map_io.h"
+#include "fdml_localization/core/util/text_parsing.h"
 
 #include <cerrno>
 #include <cmath>
@@ -32,25 +32,11 @@ struct UsageError : std::runtime_error
   using std::runtime_error::runtime_error;
 };
 
-const char* kUsage =
-    "usage: fdml_localize --map MAP [--resolution N] [--min-inliers K|auto]\n"
-    "                     [--method robust|paper|baseline] [--range-tolerance T] [--tolerance EPS]\n"
-    "                     [--threads J] [--engine voxel|adaptive] [--cache-dir DIR]\n"
-    "                     [--theta-resolution N] [--max-candidates M] [--max-range R] [--verbose]\n"
-    "                     READINGS.csv\n";
-
-std::string trim(const std::string& s)
-{
-  const auto begin = s.find_first_not_of(" \t\r\n");
-  if (begin == std::string::npos)
-  {
-    return "";
-  }
-  const auto end = s.find_last_not_of(" \t\r\n");
-  return s.substr(begin, end - begin + 1);
-}
-
-
+const char* kUsage = "usage: fdml_localize --map MAP [--resolution N] [--min-inliers K|auto]\n"
+                     "                     [--method robust|paper|baseline] [--range-tolerance T] [--tolerance EPS]\n"
+                     "                     [--threads J] [--engine voxel|adaptive] [--cache-dir DIR]\n"
+                     "                     [--theta-resolution N] [--max-candidates M] [--max-range R] [--verbose]\n"
+                     "                     READINGS.csv\n";
 
 std::vector<std::string> splitCsv(const std::string& line)
 {
@@ -59,7 +45,7 @@ std::vector<std::string> splitCsv(const std::string& line)
   std::string field;
   while (std::getline(in, field, ','))
   {
-    fields.push_back(trim(field));
+    fields.push_back(core::trim(field));
   }
   if (!line.empty() && line.back() == ',')
   {
@@ -83,7 +69,7 @@ std::vector<core::Reading> readCsv(const std::string& path, double default_max_r
   while (std::getline(in, line))
   {
     ++line_no;
-    const std::string t = trim(line);
+    const std::string t = core::trim(line);
     if (t.empty() || t[0] == '#')
     {
       continue;
@@ -102,8 +88,7 @@ std::vector<core::Reading> readCsv(const std::string& path, double default_max_r
       }
       else
       {
-        throw UsageError(where + ": expected the header 'gx,gy,gtheta,d' (optionally ',max_range'), got '" + t +
-                         "'");
+        throw UsageError(where + ": expected the header 'gx,gy,gtheta,d' (optionally ',max_range'), got '" + t + "'");
       }
       have_header = true;
       continue;
@@ -255,8 +240,7 @@ void printResult(const core::Result& result)
   int rank = 1;
   for (const core::Candidate& c : result.candidates)
   {
-    std::printf("%d,%.6f,%.6f,%.6f,%d,%.6g\n", rank++, c.pose.x, c.pose.y, c.pose.theta, c.inliers,
-                c.rms_residual);
+    std::printf("%d,%.6f,%.6f,%.6f,%d,%.6g\n", rank++, c.pose.x, c.pose.y, c.pose.theta, c.inliers, c.rms_residual);
   }
   std::fflush(stdout);
 }

@@ -7,9 +7,9 @@
  *                         [--occupied-threshold N] [--no-preview]
  * Exit status: 0 on success, 2 on bad arguments or bad input (the message names the problem).
  */
-#include "fdml_localization/core/grid_to_polygon.h"
-#include "fdml_localization/core/text_parsing.h"
-#include "fdml_localization/core/map_io.h"
+#include "fdml_localization/core/map/grid/grid_to_polygon.h"
+#include "fdml_localization/core/util/text_parsing.h"
+#include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/io/map_files.h"
 
 #include <cmath>
@@ -24,15 +24,15 @@ namespace
 namespace core = fdml_localization::core;
 namespace io = fdml_localization::io;
 
-const char* kUsage =
-    "usage: fdml_map_convert MAP.yaml OUT.poly [--tolerance M] [--min-area M2] [--seed-point X,Y]\n"
-    "                        [--occupied-threshold N] [--no-preview]\n"
-    "  --tolerance M            Douglas-Peucker tolerance [m] (default: one cell)\n"
-    "  --min-area M2            drop obstacles smaller than this [m^2] (default: ten cells)\n"
-    "  --seed-point X,Y         keep the free region holding this map point [m] (default: the largest)\n"
-    "  --occupied-threshold N   cells with value >= N (1..100) are walls (default 50); unknown is a wall\n"
-    "  --no-preview             do not write OUT.png\n";
-
+const char* kUsage = "usage: fdml_map_convert MAP.yaml OUT.poly [--tolerance M] [--min-area M2] [--seed-point X,Y]\n"
+                     "                        [--occupied-threshold N] [--no-preview]\n"
+                     "  --tolerance M            Douglas-Peucker tolerance [m] (default: one cell)\n"
+                     "  --min-area M2            drop obstacles smaller than this [m^2] (default: ten cells)\n"
+                     "  --seed-point X,Y         keep the free region holding this map point [m] (default: the "
+                     "largest)\n"
+                     "  --occupied-threshold N   cells with value >= N (1..100) are walls (default 50); unknown is a "
+                     "wall\n"
+                     "  --no-preview             do not write OUT.png\n";
 
 struct Arguments
 {
@@ -171,14 +171,13 @@ int main(int argc, char** argv)
     std::cerr << "fdml_map_convert: " << e.what() << "\n";
     return 2;
   }
-  std::cout << args.input << ": " << grid.width << " x " << grid.height << " cells at " << grid.resolution
-            << " m; " << report.regions << " free region(s), kept " << report.region_cells << " of "
-            << report.free_cells << " free cells\n"
+  std::cout << args.input << ": " << grid.width << " x " << grid.height << " cells at " << grid.resolution << " m; "
+            << report.regions << " free region(s), kept " << report.region_cells << " of " << report.free_cells
+            << " free cells\n"
             << "  holes: " << report.holes_found << " found, " << report.holes_dropped << " under "
             << report.min_area_used << " m^2 dropped, " << map.holeCount() << " kept\n"
             << "  vertices: " << report.vertices_traced << " traced, " << report.vertices_kept << " kept (tolerance "
             << report.tolerance_used << " m, " << report.rings_tightened << " ring(s) tightened to stay valid)\n"
-            << "  free area " << map.area() << " m^2 -> " << args.output << (args.preview ? " and " + png : "")
-            << "\n";
+            << "  free area " << map.area() << " m^2 -> " << args.output << (args.preview ? " and " + png : "") << "\n";
   return 0;
 }

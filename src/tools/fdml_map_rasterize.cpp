@@ -7,9 +7,9 @@
  *                           [--noise P] [--specks N] [--islands N] [--seed S]
  * Exit status: 0 on success, 2 on bad arguments or bad input.
  */
-#include "fdml_localization/core/grid_to_polygon.h"
-#include "fdml_localization/core/text_parsing.h"
-#include "fdml_localization/core/map_io.h"
+#include "fdml_localization/core/map/grid/grid_raster.h"
+#include "fdml_localization/core/util/text_parsing.h"
+#include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/io/map_files.h"
 
 #include <cmath>
@@ -22,17 +22,15 @@ namespace
 namespace core = fdml_localization::core;
 namespace io = fdml_localization::io;
 
-const char* kUsage =
-    "usage: fdml_map_rasterize IN.poly OUT.yaml [--resolution M] [--margin M] [--wall M]\n"
-    "                          [--noise P] [--specks N] [--islands N] [--seed S]\n"
-    "  --resolution M  cell edge [m] (default 0.05)\n"
-    "  --margin M      unknown border around the map [m] (default 0.5)\n"
-    "  --wall M        wall thickness drawn around free space [m] (default 0.15)\n"
-    "  --noise P       probability a free cell beside a wall turns occupied, 0..1 (default 0)\n"
-    "  --specks N      small occupied blobs in free space (default 0)\n"
-    "  --islands N     small free blobs in the unknown area (default 0)\n"
-    "  --seed S        random seed (default 1)\n";
-
+const char* kUsage = "usage: fdml_map_rasterize IN.poly OUT.yaml [--resolution M] [--margin M] [--wall M]\n"
+                     "                          [--noise P] [--specks N] [--islands N] [--seed S]\n"
+                     "  --resolution M  cell edge [m] (default 0.05)\n"
+                     "  --margin M      unknown border around the map [m] (default 0.5)\n"
+                     "  --wall M        wall thickness drawn around free space [m] (default 0.15)\n"
+                     "  --noise P       probability a free cell beside a wall turns occupied, 0..1 (default 0)\n"
+                     "  --specks N      small occupied blobs in free space (default 0)\n"
+                     "  --islands N     small free blobs in the unknown area (default 0)\n"
+                     "  --seed S        random seed (default 1)\n";
 
 int parseCount(const std::string& text, const std::string& option)
 {

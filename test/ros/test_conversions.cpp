@@ -83,8 +83,9 @@ TEST(Conversions, MarkersCarryTheGeometry)
   const auto walls = fl::mapMarkers(map, "map", ros::Time(1.0));
   ASSERT_EQ(walls.markers.size(), 1u);
   EXPECT_EQ(walls.markers[0].points.size(), 2 * map.edges().size());
-  const std::vector<core::Obstacle> obstacles = { core::Obstacle::disc(Vec2(0.5, 0.5), 0.1),
-                                                  core::Obstacle::polygon({ Vec2(1, 0.2), Vec2(1.3, 0.2), Vec2(1.1, 0.5) }) };
+  const std::vector<core::Obstacle> obstacles = {
+    core::Obstacle::disc(Vec2(0.5, 0.5), 0.1), core::Obstacle::polygon({ Vec2(1, 0.2), Vec2(1.3, 0.2), Vec2(1.1, 0.5) })
+  };
   const auto markers = fl::obstacleMarkers(obstacles, "map", ros::Time(1.0), 4);
   ASSERT_EQ(markers.markers.size(), 4u);
   EXPECT_EQ(markers.markers[0].type, visualization_msgs::Marker::CYLINDER);
@@ -289,8 +290,8 @@ TEST(LocalizerConversions, RangeFollowsRep117)
   EXPECT_EQ(reading.range, core::kInf);
 
   const std::pair<double, const char*> dropped[] = {
-    { kNan, drop_reason::kNanRange },           { -core::kInf, drop_reason::kNegativeInfinity },
-    { -1.0, drop_reason::kNegativeRange },      { 0.01, drop_reason::kBelowMinRange },
+    { kNan, drop_reason::kNanRange },      { -core::kInf, drop_reason::kNegativeInfinity },
+    { -1.0, drop_reason::kNegativeRange }, { 0.01, drop_reason::kBelowMinRange },
     { 4.5, drop_reason::kAboveMaxRange },
   };
   for (const auto& entry : dropped)

@@ -100,8 +100,7 @@ TEST(MapLoading, LoadsAMapServerYamlAsAPolygon)
   for (const core::Pose2& pose : { core::Pose2(1.0, 1.0, 0.0), core::Pose2(3.0, 2.0, 1.2), core::Pose2(0.7, 3.5, -2.5),
                                    core::Pose2(5.0, 0.5, 2.9), core::Pose2(2.5, 1.75, core::kPi) })
   {
-    EXPECT_NEAR(loaded.map->range(pose), polygon->range(pose), 0.1)
-        << pose.x << ", " << pose.y << ", " << pose.theta;
+    EXPECT_NEAR(loaded.map->range(pose), polygon->range(pose), 0.1) << pose.x << ", " << pose.y << ", " << pose.theta;
   }
   // A .poly file is no grid.
   EXPECT_EQ(loadMapFromFile(kTestMap).grid_resolution, 0.0);

@@ -216,16 +216,22 @@ TEST(Params, AgreesWithTheCoreValidation)
   }
   // ... and every core option the core rejects, the node rejects first (naming the parameter).
   std::vector<std::function<void(Params&)>> rejected = {
-    [](Params& p) { p.resolution = 15; },         [](Params& p) { p.resolution = 1025; },
+    [](Params& p) { p.resolution = 15; },
+    [](Params& p) { p.resolution = 1025; },
     [](Params& p) {
       p.engine = "adaptive";
       p.resolution = 100001;
     },
-    [](Params& p) { p.theta_resolution = 15; },   [](Params& p) { p.min_inliers = 2; },
-    [](Params& p) { p.agreement_tolerance = 0.0; }, [](Params& p) { p.uniqueness_distance = -1.0; },
-    [](Params& p) { p.uniqueness_angle = -1.0; }, [](Params& p) { p.range_tolerance = -0.01; },
-    [](Params& p) { p.max_candidates = 0; },      [](Params& p) { p.threads = -1; },
-    [](Params& p) { p.max_boxes = 999; },         [](Params& p) { p.deadline = -1.0; },
+    [](Params& p) { p.theta_resolution = 15; },
+    [](Params& p) { p.min_inliers = 2; },
+    [](Params& p) { p.agreement_tolerance = 0.0; },
+    [](Params& p) { p.uniqueness_distance = -1.0; },
+    [](Params& p) { p.uniqueness_angle = -1.0; },
+    [](Params& p) { p.range_tolerance = -0.01; },
+    [](Params& p) { p.max_candidates = 0; },
+    [](Params& p) { p.threads = -1; },
+    [](Params& p) { p.max_boxes = 999; },
+    [](Params& p) { p.deadline = -1.0; },
     [](Params& p) { p.method = "paper"; },
   };
   for (std::size_t i = 0; i < rejected.size(); ++i)
@@ -261,11 +267,28 @@ TEST(Params, CacheDirExpansion)
 TEST(Params, DescribeListsEveryParameter)
 {
   const std::string text = describe(validParams());
-  for (const char* name :
-       { "map_file", "measurements_per_batch", "batch_stride", "mode", "beams_per_scan", "transform_tolerance",
-         "relocalize_timeout", "publish_tf", "engine", "method", "resolution", "theta_resolution", "min_inliers",
-         "agreement_tolerance", "uniqueness_distance", "uniqueness_angle", "range_tolerance", "max_candidates",
-         "threads", "cache_dir", "max_boxes", "deadline" })
+  for (const char* name : { "map_file",
+                            "measurements_per_batch",
+                            "batch_stride",
+                            "mode",
+                            "beams_per_scan",
+                            "transform_tolerance",
+                            "relocalize_timeout",
+                            "publish_tf",
+                            "engine",
+                            "method",
+                            "resolution",
+                            "theta_resolution",
+                            "min_inliers",
+                            "agreement_tolerance",
+                            "uniqueness_distance",
+                            "uniqueness_angle",
+                            "range_tolerance",
+                            "max_candidates",
+                            "threads",
+                            "cache_dir",
+                            "max_boxes",
+                            "deadline" })
   {
     EXPECT_NE(text.find(name), std::string::npos) << name;
   }
@@ -306,8 +329,16 @@ TEST(Params, GridConversionParametersAreValidated)
     { "map_min_area", [nan](Params& p) { p.map_min_area = nan; }, "[0, 1e6] m^2" },
     { "map_min_area", [inf](Params& p) { p.map_min_area = inf; }, "[0, 1e6] m^2" },
     { "map_seed_point", [](Params& p) { p.map_seed_point = { 1.0 }; }, "two finite numbers" },
-    { "map_seed_point", [](Params& p) { p.map_seed_point = { 1.0, 2.0, 3.0 }; }, "two finite numbers" },
-    { "map_seed_point", [inf](Params& p) { p.map_seed_point = { 1.0, inf }; }, "two finite numbers" },
+    { "map_seed_point",
+      [](Params& p) {
+        p.map_seed_point = { 1.0, 2.0, 3.0 };
+      },
+      "two finite numbers" },
+    { "map_seed_point",
+      [inf](Params& p) {
+        p.map_seed_point = { 1.0, inf };
+      },
+      "two finite numbers" },
     { "map_seed_point", [](Params& p) { p.map_seed_point_malformed = true; }, "two finite numbers" },
     { "map_occupied_threshold", [](Params& p) { p.map_occupied_threshold = 0; }, "[1, 100]" },
     { "map_occupied_threshold", [](Params& p) { p.map_occupied_threshold = 101; }, "[1, 100]" },
@@ -384,8 +415,8 @@ TEST(Params, GridMapsWidenTheTolerancesTheUserDidNotSet)
 TEST(Params, DescribeListsTheMapParameters)
 {
   const std::string text = describe(validParams());
-  for (const char* name : { "use_map_topic", "map_simplify_tolerance", "map_min_area", "map_seed_point",
-                            "map_occupied_threshold" })
+  for (const char* name :
+       { "use_map_topic", "map_simplify_tolerance", "map_min_area", "map_seed_point", "map_occupied_threshold" })
   {
     EXPECT_NE(text.find(name), std::string::npos) << name;
   }

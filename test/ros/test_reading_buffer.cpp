@@ -184,11 +184,11 @@ TEST(ReadingBuffer, OnRequestModeSolvesOnceOnFreshReadings)
   }
   buffer.resolve(1.0, "base_link", std::ref(tf));
   Batch batch;
-  EXPECT_FALSE(buffer.takeBatch(&batch));      // no request yet
-  EXPECT_EQ(buffer.resolvedCount(), 3u);       // idle: only the newest k kept
+  EXPECT_FALSE(buffer.takeBatch(&batch));  // no request yet
+  EXPECT_EQ(buffer.resolvedCount(), 3u);   // idle: only the newest k kept
   buffer.requestBatch();
   EXPECT_TRUE(buffer.batchRequested());
-  EXPECT_EQ(buffer.resolvedCount(), 0u);       // old readings are not used
+  EXPECT_EQ(buffer.resolvedCount(), 0u);  // old readings are not used
   for (int i = 6; i <= 9; ++i)
   {
     buffer.add(reading("front", i * 0.1));
@@ -198,7 +198,7 @@ TEST(ReadingBuffer, OnRequestModeSolvesOnceOnFreshReadings)
   EXPECT_NEAR(seconds(batch.first_stamp), 0.6, 1e-12);
   EXPECT_NEAR(seconds(batch.newest_stamp), 0.8, 1e-12);
   EXPECT_FALSE(buffer.batchRequested());
-  EXPECT_FALSE(buffer.takeBatch(&batch));      // one batch per request
+  EXPECT_FALSE(buffer.takeBatch(&batch));  // one batch per request
   EXPECT_EQ(buffer.dropped(), 0u);
 }
 
@@ -209,8 +209,8 @@ TEST(ReadingBuffer, MalformedReadingsAreDroppedAndCountedByReason)
   EXPECT_TRUE(buffer.add(reading("front", 5.0)));
   EXPECT_FALSE(buffer.add(reading("front", 4.0), &reason));  // backwards in its frame
   EXPECT_EQ(reason, drop_reason::kStampBackwards);
-  EXPECT_TRUE(buffer.add(reading("front", 5.0)));            // equal stamps are fine
-  EXPECT_TRUE(buffer.add(reading("back", 4.0)));             // other frames are independent
+  EXPECT_TRUE(buffer.add(reading("front", 5.0)));  // equal stamps are fine
+  EXPECT_TRUE(buffer.add(reading("back", 4.0)));   // other frames are independent
   EXPECT_FALSE(buffer.add(reading("", 6.0), &reason));
   EXPECT_EQ(reason, drop_reason::kEmptyFrameId);
   EXPECT_FALSE(buffer.add(reading("front", 0.0), &reason));
@@ -235,7 +235,7 @@ TEST(ReadingBuffer, ReadingsWaitForTransformsUpToTheTolerance)
 
   tf.now = 10.05;
   EXPECT_TRUE(buffer.resolve(tf.now, "base_link", std::ref(tf)).empty());
-  EXPECT_EQ(buffer.pendingCount(), 2u);   // "late" and "ghost" wait; "front" is ready
+  EXPECT_EQ(buffer.pendingCount(), 2u);  // "late" and "ghost" wait; "front" is ready
   EXPECT_EQ(buffer.resolvedCount(), 1u);
 
   tf.now = 10.15;  // "late" is available now, within the 0.2 s tolerance

@@ -21,8 +21,7 @@ public:
       std::lock_guard<std::mutex> lock(mutex_);
       messages_.push_back(*msg);
     }))
-  {
-  }
+  {}
 
   /// Waits until a received message satisfies @p pred (copied to @p found when given);
   /// false when none did within @p timeout [s] of wall time.

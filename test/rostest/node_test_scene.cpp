@@ -1,6 +1,6 @@
 #include "node_test_scene.h"
 
-#include "fdml_localization/core/map_io.h"
+#include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/ros/conversions.h"
 
 #include <geometry_msgs/TransformStamped.h>
@@ -17,8 +17,7 @@ std::string testMapPath()
 }
 
 TurningScene::TurningScene() : map(std::make_shared<const core::MapRayCaster>(core::loadPolyFile(testMapPath())))
-{
-}
+{}
 
 core::Pose2 TurningScene::baseInMap(int j) const
 {

@@ -6,7 +6,7 @@
  */
 #pragma once
 
-#include "fdml_localization/core/ray_caster.h"
+#include "fdml_localization/core/geometry/ray_caster.h"
 
 #include <fdml_localization/Reading.h>
 #include <ros/ros.h>
@@ -30,12 +30,12 @@ struct TurningScene
   TurningScene();
 
   std::shared_ptr<const core::MapRayCaster> map;
-  core::Pose2 start{ 2.8, 1.2, 0.3 };        ///< base in the map at reading 0
-  core::Pose2 map_to_odom{ 0.7, -0.4, 0.9 };  ///< the true map -> odom transform
-  core::Pose2 mount{ 0.12, 0.03, 0.0 };       ///< base_link -> range_sensor
+  core::Pose2 start{ 2.8, 1.2, 0.3 };           ///< base in the map at reading 0
+  core::Pose2 map_to_odom{ 0.7, -0.4, 0.9 };    ///< the true map -> odom transform
+  core::Pose2 mount{ 0.12, 0.03, 0.0 };         ///< base_link -> range_sensor
   core::Pose2 laser_mount{ 0.05, -0.02, 0.0 };  ///< base_link -> laser
-  int k = 10;                                 ///< readings per turn (2 pi / k apart)
-  double max_range = 8.0;                     ///< [m]
+  int k = 10;                                   ///< readings per turn (2 pi / k apart)
+  double max_range = 8.0;                       ///< [m]
 
   /// Base pose in the map at reading j: turning in place by 2 pi / k per reading.
   core::Pose2 baseInMap(int j) const;

@@ -1,6 +1,6 @@
 // rostest: the fdml_localizer binary exits non-zero, naming the problem, for a missing map file,
-// a map_server YAML whose image is missing, an out-of-range parameter and a missing ~map_file (run as a child process against the
-// rostest's master).
+// a map_server YAML whose image is missing, an out-of-range parameter and a missing ~map_file (run as a child process
+// against the rostest's master).
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
@@ -96,7 +96,8 @@ TEST(LocalizerBadParams, YamlWithAMissingImageExitsNonZeroNamingTheImage)
   const std::string path = stem + ".yaml";
   FILE* file = std::fopen(path.c_str(), "w");
   ASSERT_NE(file, nullptr);
-  std::fputs(("image: " + stem + "_missing.pgm\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\n"
+  std::fputs(("image: " + stem +
+              "_missing.pgm\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\n"
               "occupied_thresh: 0.65\nfree_thresh: 0.196\nnegate: 0\n")
                  .c_str(),
              file);

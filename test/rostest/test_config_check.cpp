@@ -1,5 +1,5 @@
 // Every shipped YAML passes the validation of the node that reads it (see config_check.test).
-#include "fdml_localization/core/scenario.h"
+#include "fdml_localization/simulation/scenario.h"
 #include "fdml_localization/ros/param_utils.h"
 #include "fdml_localization/ros/params.h"
 

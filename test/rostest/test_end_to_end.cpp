@@ -29,7 +29,8 @@ struct TruthSample
 class TruthHistory
 {
 public:
-  explicit TruthHistory(ros::NodeHandle& nh) : sub_(nh.subscribe("ground_truth", 500, &TruthHistory::onOdom, this)) {}
+  explicit TruthHistory(ros::NodeHandle& nh) : sub_(nh.subscribe("ground_truth", 500, &TruthHistory::onOdom, this))
+  {}
 
   bool at(const ros::Time& stamp, TruthSample& out)
   {
@@ -75,7 +76,8 @@ private:
 class MapToOdomRecorder
 {
 public:
-  explicit MapToOdomRecorder(ros::NodeHandle& nh) : sub_(nh.subscribe("/tf", 100, &MapToOdomRecorder::onTf, this)) {}
+  explicit MapToOdomRecorder(ros::NodeHandle& nh) : sub_(nh.subscribe("/tf", 100, &MapToOdomRecorder::onTf, this))
+  {}
 
   std::uint64_t count()
   {
@@ -180,15 +182,16 @@ TEST(EndToEnd, KidnapsAreRelocalizedAndTfFollows)
     ROS_INFO("kidnap %d: truth (%.3f, %.3f, %.3f), error %.1f cm %.2f deg, %zu candidates: %s", n, t.x, t.y, t.yaw,
              100.0 * err_pos, err_ang * 180.0 / M_PI, result.candidates.size(), srv.response.message.c_str());
 
-    const bool unambiguous = result.candidates.size() == 1 || result.candidates[0].inliers > result.candidates[1].inliers;
+    const bool unambiguous =
+        result.candidates.size() == 1 || result.candidates[0].inliers > result.candidates[1].inliers;
     if (ok && unambiguous)
     {
       // The map -> odom the localizer publishes after this answer (future-dated, as AMCL does, so a
       // tf lookup between the old and the new one would interpolate between them) composed with
       // the simulator's odom -> base_link at the result's stamp is the true pose at that stamp.
       geometry_msgs::TransformStamped map_to_odom;
-      ASSERT_TRUE(waitFor([&] { return map_odom.latestAfter(answered, map_to_odom); }, 10.0))
-          << "no map -> odom on tf after the answer";
+      ASSERT_TRUE(waitFor([&] { return map_odom.latestAfter(answered, map_to_odom); }, 10.0)) << "no map -> odom on tf "
+                                                                                                 "after the answer";
       std::string error;
       ASSERT_TRUE(tf_buffer.canTransform("odom", "base_link", result.header.stamp, ros::Duration(5.0), &error))
           << error;

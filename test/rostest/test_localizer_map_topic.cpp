@@ -5,7 +5,8 @@
 // node loads a map_server YAML as ~map_file.
 #include "node_test_scene.h"
 
-#include "fdml_localization/core/grid_to_polygon.h"
+#include "fdml_localization/core/map/grid/grid_to_polygon.h"
+#include "fdml_localization/core/map/grid/grid_raster.h"
 #include "fdml_localization/ros/conversions.h"
 #include "message_collector.h"
 
@@ -31,7 +32,7 @@ namespace
 {
 // A converted grid's walls are good to about a cell (5 cm): the estimate is a little looser
 // than on the polygon itself.
-constexpr double kPositionTolerance = 0.08;                 // [m]
+constexpr double kPositionTolerance = 0.08;                  // [m]
 constexpr double kAngleTolerance = 3.0 * core::kPi / 180.0;  // [rad]
 constexpr double kMapTimeout = 120.0;                        // [s] conversion and tables on a loaded machine
 

@@ -30,7 +30,7 @@ namespace test
 {
 namespace
 {
-constexpr double kPositionTolerance = 0.05;                 // [m]
+constexpr double kPositionTolerance = 0.05;                  // [m]
 constexpr double kAngleTolerance = 2.0 * core::kPi / 180.0;  // [rad]
 constexpr std::uint32_t kLocalizerNodes = 2;                 // localizer_node.test starts two
 
@@ -140,7 +140,8 @@ TEST(LocalizerNode, RelocalizeWhileTurningInPlaceFlagsTheOccludedReadings)
       [&response](const geometry_msgs::PoseArray& msg) { return msg.header.stamp == response.result.header.stamp; },
       10.0, &poses));
   ASSERT_FALSE(poses.poses.empty());
-  expectWithinTolerance(fromPoseMsg(poses.poses.front()), scene.baseInMap(last), "~candidates[0] at the newest reading");
+  expectWithinTolerance(fromPoseMsg(poses.poses.front()), scene.baseInMap(last),
+                        "~candidates[0] at the newest reading");
 
   // map -> odom on tf when the best is unambiguous (more inliers than the second).
   const auto& cands = response.result.candidates;
@@ -250,7 +251,9 @@ TEST(LocalizerNode, ContinuousModeSolvesEveryBatchAndPublishesThePose)
   // ~pose: the best, carried forward to the newest reading, with a positive covariance.
   geometry_msgs::PoseWithCovarianceStamped pose;
   ASSERT_TRUE(poses.waitFor(
-      [&result](const geometry_msgs::PoseWithCovarianceStamped& msg) { return msg.header.stamp == result.header.stamp; },
+      [&result](const geometry_msgs::PoseWithCovarianceStamped& msg) {
+        return msg.header.stamp == result.header.stamp;
+      },
       10.0, &pose));
   expectWithinTolerance(fromPoseMsg(pose.pose.pose), scene.baseInMap(last), "~pose");
   EXPECT_GT(pose.pose.covariance[0], 0.0);
@@ -272,11 +275,11 @@ TEST(LocalizerNode, MalformedInputIsCountedAndTheNodeStillLocalizes)
   publisher.publishRange(nan, "range_sensor", stamp + ros::Duration(0.001));
   publisher.publishRange(-1.0, "range_sensor", stamp + ros::Duration(0.002));
   publisher.publishRange(1.0, "", stamp + ros::Duration(0.003));
-  publisher.publishRange(1.0, "range_sensor", stamp - ros::Duration(0.5));  // backwards in its frame
+  publisher.publishRange(1.0, "range_sensor", stamp - ros::Duration(0.5));    // backwards in its frame
   publisher.publishRange(1.0, "ghost_sensor", stamp + ros::Duration(0.004));  // never on tf
 
   const std::map<std::string, std::string> expected = {
-    { "dropped: nan_range", "1" },      { "dropped: negative_range", "1" }, { "dropped: empty_frame_id", "1" },
+    { "dropped: nan_range", "1" },       { "dropped: negative_range", "1" }, { "dropped: empty_frame_id", "1" },
     { "dropped: stamp_backwards", "1" }, { "dropped: unknown_frame", "1" },
   };
   diagnostic_msgs::DiagnosticArray found;

@@ -3,7 +3,7 @@
 // pose built from the ground_truth topic and the static tf of the sensor mounting.
 #include "fdml_localization/Kidnap.h"
 #include "fdml_localization/ReadingTruth.h"
-#include "fdml_localization/core/map_io.h"
+#include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/ros/conversions.h"
 #include "fdml_localization/ros/param_utils.h"
 
@@ -80,13 +80,20 @@ protected:
     {
       return core::Pose2();
     }
-    const core::Pose2 pose = fl::fromTransformMsg(tf_buffer_->lookupTransform("base_link", frame, ros::Time(0)).transform);
+    const core::Pose2 pose =
+        fl::fromTransformMsg(tf_buffer_->lookupTransform("base_link", frame, ros::Time(0)).transform);
     mounts_[frame] = pose;
     return pose;
   }
 
-  void onRange(const sensor_msgs::Range::ConstPtr& msg) { ranges_.push_back(*msg); }
-  void onTruth(const fl::ReadingTruth::ConstPtr& msg) { truths_.push_back(*msg); }
+  void onRange(const sensor_msgs::Range::ConstPtr& msg)
+  {
+    ranges_.push_back(*msg);
+  }
+  void onTruth(const fl::ReadingTruth::ConstPtr& msg)
+  {
+    truths_.push_back(*msg);
+  }
   void onOdom(const nav_msgs::Odometry::ConstPtr& msg)
   {
     odom_[msg->header.stamp] = fl::fromPoseMsg(msg->pose.pose);
@@ -125,12 +132,10 @@ protected:
 };
 
 class Noiseless : public SimulatorTest
-{
-};
+{};
 
 class Obstacles : public SimulatorTest
-{
-};
+{};
 
 void expectRangeEq(double actual, double expected, double tolerance, const std::string& what)
 {

@@ -7,9 +7,9 @@
  */
 #pragma once
 
-#include "fdml_localization/core/grid_to_polygon.h"
-#include "fdml_localization/core/occupancy_grid.h"
-#include "fdml_localization/core/polygon_map.h"
+#include "fdml_localization/core/map/grid/grid_to_polygon.h"
+#include "fdml_localization/core/map/grid/occupancy_grid.h"
+#include "fdml_localization/core/map/polygon_map.h"
 
 #include <string>
 

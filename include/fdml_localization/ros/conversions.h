@@ -6,10 +6,10 @@
  */
 #pragma once
 
-#include "fdml_localization/core/ray_caster.h"
-#include "fdml_localization/core/scene.h"
-#include "fdml_localization/core/localizer.h"
-#include "fdml_localization/core/occupancy_grid.h"
+#include "fdml_localization/core/geometry/ray_caster.h"
+#include "fdml_localization/simulation/scene.h"
+#include "fdml_localization/core/localization/localizer.h"
+#include "fdml_localization/core/map/grid/occupancy_grid.h"
 #include "fdml_localization/ros/reading_buffer.h"
 
 #include <fdml_localization/Candidate.h>
@@ -81,9 +81,8 @@ visualization_msgs::MarkerArray mapMarkers(const core::PolygonMap& map, const st
  *        disc, a closed LINE_STRIP for a polygon. Markers of ids >= obstacles.size() up to
  *        @p previous_count are deleted.
  */
-visualization_msgs::MarkerArray obstacleMarkers(const std::vector<core::Obstacle>& obstacles,
-                                                const std::string& frame, const ros::Time& stamp,
-                                                std::size_t previous_count = 0);
+visualization_msgs::MarkerArray obstacleMarkers(const std::vector<core::Obstacle>& obstacles, const std::string& frame,
+                                                const ros::Time& stamp, std::size_t previous_count = 0);
 
 /**
  * @brief Rasterizes the map: a cell is occupied (100) when a wall passes through it or its
@@ -94,8 +93,8 @@ visualization_msgs::MarkerArray obstacleMarkers(const std::vector<core::Obstacle
  * @param frame frame of the map
  * @param stamp header stamp
  */
-nav_msgs::OccupancyGrid toOccupancyGrid(const core::MapRayCaster& caster, double resolution,
-                                        const std::string& frame, const ros::Time& stamp);
+nav_msgs::OccupancyGrid toOccupancyGrid(const core::MapRayCaster& caster, double resolution, const std::string& frame,
+                                        const ros::Time& stamp);
 
 /**
  * @brief A nav_msgs/OccupancyGrid as a core grid: sizes, resolution and cells copied unchanged

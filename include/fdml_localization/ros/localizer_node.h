@@ -31,7 +31,7 @@
  */
 #pragma once
 
-#include "fdml_localization/core/localizer.h"
+#include "fdml_localization/core/localization/localizer.h"
 #include "fdml_localization/ros/map_loading.h"
 #include "fdml_localization/ros/params.h"
 #include "fdml_localization/ros/reading_buffer.h"
@@ -106,8 +106,8 @@ private:
   struct Job
   {
     std::vector<core::Reading> readings;
-    bool from_sensors = false;  ///< true: a tf batch (published); false: a ~localize request
-    Batch batch;                ///< from_sensors only
+    bool from_sensors = false;     ///< true: a tf batch (published); false: a ~localize request
+    Batch batch;                   ///< from_sensors only
     std::uint64_t generation = 0;  ///< relocalization_generation_ when the batch was formed
     std::vector<OutcomePromise> waiters;
   };
@@ -152,12 +152,12 @@ private:
   Params params_;
   SolveMode mode_;
   std::shared_ptr<const core::MapRayCaster> map_;  ///< null until a map; swapped by the worker only
-  std::unique_ptr<core::Localizer> localizer_;  ///< used by the worker thread only; null until a map
+  std::unique_ptr<core::Localizer> localizer_;     ///< used by the worker thread only; null until a map
 
   ros::NodeHandle nh_;
   ros::NodeHandle private_nh_;
-  ros::NodeHandle service_nh_;           ///< private namespace on service_queue_
-  ros::NodeHandle global_service_nh_;    ///< node namespace on service_queue_
+  ros::NodeHandle service_nh_;         ///< private namespace on service_queue_
+  ros::NodeHandle global_service_nh_;  ///< node namespace on service_queue_
   ros::CallbackQueue service_queue_;
   std::unique_ptr<ros::AsyncSpinner> service_spinner_;
 
@@ -186,28 +186,28 @@ private:
   std::mutex mutex_;
   std::condition_variable work_ready_;  ///< signalled when a job is queued or on shutdown
   ReadingBuffer buffer_;
-  std::unique_ptr<Job> queued_batch_;   ///< newest sensor batch not yet taken by the worker
-  std::deque<Job> queued_requests_;     ///< ~localize requests, FIFO
+  std::unique_ptr<Job> queued_batch_;               ///< newest sensor batch not yet taken by the worker
+  std::deque<Job> queued_requests_;                 ///< ~localize requests, FIFO
   std::vector<OutcomePromise> relocalize_waiters_;  ///< for the next sensor batch
   bool shutting_down_ = false;
   std::uint64_t relocalization_generation_ = 0;  ///< bumped by every relocalization request
   bool have_map_to_odom_ = false;
-  core::Pose2 map_to_odom_;             ///< last unambiguous map -> odom
+  core::Pose2 map_to_odom_;  ///< last unambiguous map -> odom
   std::uint64_t batches_solved_ = 0;
   std::uint64_t batches_replaced_ = 0;
   std::uint64_t solve_errors_ = 0;
-  double last_solve_time_ = 0.0;        ///< [s]
-  int last_candidates_ = -1;            ///< -1: nothing solved yet
+  double last_solve_time_ = 0.0;  ///< [s]
+  int last_candidates_ = -1;      ///< -1: nothing solved yet
   bool last_unambiguous_ = false;
   std::string last_error_;
-  std::string state_ = "starting";      ///< human-readable worker state
+  std::string state_ = "starting";                 ///< human-readable worker state
   nav_msgs::OccupancyGrid::ConstPtr pending_map_;  ///< newest map message not yet taken by the worker
-  bool have_map_ = false;               ///< a map is in use (or will be, once the worker prepared it)
-  std::string map_source_;              ///< where the map in use came from
-  std::uint64_t maps_received_ = 0;     ///< map messages received
-  std::uint64_t maps_accepted_ = 0;     ///< map messages converted and in use
-  std::uint64_t maps_rejected_ = 0;     ///< map messages that could not be used
-  std::uint64_t maps_replaced_ = 0;     ///< map messages replaced by a newer one before conversion
+  bool have_map_ = false;                          ///< a map is in use (or will be, once the worker prepared it)
+  std::string map_source_;                         ///< where the map in use came from
+  std::uint64_t maps_received_ = 0;                ///< map messages received
+  std::uint64_t maps_accepted_ = 0;                ///< map messages converted and in use
+  std::uint64_t maps_rejected_ = 0;                ///< map messages that could not be used
+  std::uint64_t maps_replaced_ = 0;                ///< map messages replaced by a newer one before conversion
   std::string last_map_error_;
 
   std::thread worker_;  ///< started last, joined in the destructor

@@ -5,8 +5,8 @@
  */
 #pragma once
 
-#include "fdml_localization/core/grid_to_polygon.h"
-#include "fdml_localization/core/ray_caster.h"
+#include "fdml_localization/core/map/grid/grid_to_polygon.h"
+#include "fdml_localization/core/geometry/ray_caster.h"
 
 #include <memory>
 #include <stdexcept>

@@ -5,7 +5,7 @@
  */
 #pragma once
 
-#include "fdml_localization/core/param_tree.h"
+#include "fdml_localization/core/util/param_tree.h"
 
 #include <ros/node_handle.h>
 #include <xmlrpcpp/XmlRpcValue.h>

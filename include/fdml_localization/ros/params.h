@@ -5,8 +5,8 @@
  */
 #pragma once
 
-#include "fdml_localization/core/grid_to_polygon.h"
-#include "fdml_localization/core/localizer.h"
+#include "fdml_localization/core/map/grid/grid_to_polygon.h"
+#include "fdml_localization/core/localization/localizer.h"
 
 #include <string>
 #include <vector>
@@ -36,24 +36,24 @@ struct Params
   /// ~map_file: a .poly file or a map_server .yaml, absolute, file://... or package://...;
   /// required unless use_map_topic (then optional: the map used until one arrives on the topic)
   std::string map_file;
-  bool use_map_topic = false;        ///< ~use_map_topic: take nav_msgs/OccupancyGrid maps from `map`
+  bool use_map_topic = false;  ///< ~use_map_topic: take nav_msgs/OccupancyGrid maps from `map`
 
   // Occupancy grid -> polygon conversion (a .yaml ~map_file or the map topic).
   double map_simplify_tolerance = 0.0;  ///< ~map_simplify_tolerance [m]: 0 = one cell, else (0, 10]
-  double map_min_area = -1.0;        ///< ~map_min_area [m^2]: obstacles smaller are specks; < 0 = ten cells
+  double map_min_area = -1.0;           ///< ~map_min_area [m^2]: obstacles smaller are specks; < 0 = ten cells
   /// ~map_seed_point [m]: [x, y] in the map frame, keep the free region holding it; empty =
   /// the largest free region. A malformed value is kept here as given (validate() reports it).
   std::vector<double> map_seed_point;
   bool map_seed_point_malformed = false;  ///< set by loadParams() when ~map_seed_point is not a list of numbers
-  int map_occupied_threshold = 50;   ///< ~map_occupied_threshold: cells >= this are walls, [1, 100]
-  int measurements_per_batch = 10;   ///< ~measurements_per_batch: k, in [3, 255]
-  int batch_stride = 1;              ///< ~batch_stride: readings the window slides by, in [1, k]
-  std::string mode = "on_request";   ///< ~mode: on_request | continuous
-  int beams_per_scan = 10;           ///< ~beams_per_scan: readings taken from a LaserScan, [1, 1000]
-  double transform_tolerance = 0.1;  ///< ~transform_tolerance [s]: tf wait and tf future-dating, [0, 10]
-  double relocalize_timeout = 30.0;  ///< ~relocalize_timeout [s]: default ~relocalize wait, (0, 3600]
-  bool publish_tf = false;           ///< ~publish_tf: publish map -> odom for an unambiguous best
-  double tf_publish_rate = 10.0;     ///< ~tf_publish_rate [Hz]: map -> odom republish rate, (0, 1000]
+  int map_occupied_threshold = 50;        ///< ~map_occupied_threshold: cells >= this are walls, [1, 100]
+  int measurements_per_batch = 10;        ///< ~measurements_per_batch: k, in [3, 255]
+  int batch_stride = 1;                   ///< ~batch_stride: readings the window slides by, in [1, k]
+  std::string mode = "on_request";        ///< ~mode: on_request | continuous
+  int beams_per_scan = 10;                ///< ~beams_per_scan: readings taken from a LaserScan, [1, 1000]
+  double transform_tolerance = 0.1;       ///< ~transform_tolerance [s]: tf wait and tf future-dating, [0, 10]
+  double relocalize_timeout = 30.0;       ///< ~relocalize_timeout [s]: default ~relocalize wait, (0, 3600]
+  bool publish_tf = false;                ///< ~publish_tf: publish map -> odom for an unambiguous best
+  double tf_publish_rate = 10.0;          ///< ~tf_publish_rate [Hz]: map -> odom republish rate, (0, 1000]
 
   // Frames (AMCL names).
   std::string global_frame_id = "map";
@@ -65,22 +65,22 @@ struct Params
   std::string scan_topic = "scan";
 
   // Core options (see core::LocalizerOptions for meanings).
-  std::string engine = "voxel";      ///< ~engine: voxel | adaptive
-  std::string method = "robust";     ///< ~method: robust | paper | baseline
-  int resolution = 100;              ///< ~resolution
-  int theta_resolution = 0;          ///< ~theta_resolution: 0 = resolution, else in [16, 1024]
-  int min_inliers = 0;               ///< ~min_inliers: k', 0 = automatic, else in [3, k] (fixed for paper)
-  double agreement_tolerance = 0.05; ///< ~agreement_tolerance [m]
+  std::string engine = "voxel";          ///< ~engine: voxel | adaptive
+  std::string method = "robust";         ///< ~method: robust | paper | baseline
+  int resolution = 100;                  ///< ~resolution
+  int theta_resolution = 0;              ///< ~theta_resolution: 0 = resolution, else in [16, 1024]
+  int min_inliers = 0;                   ///< ~min_inliers: k', 0 = automatic, else in [3, k] (fixed for paper)
+  double agreement_tolerance = 0.05;     ///< ~agreement_tolerance [m]
   bool agreement_tolerance_set = false;  ///< the user set ~agreement_tolerance (see withGridTolerances())
-  double uniqueness_distance = 0.1;  ///< ~uniqueness_distance [m]
-  double uniqueness_angle = 0.1;     ///< ~uniqueness_angle [rad]
-  double range_tolerance = 0.02;     ///< ~range_tolerance [m]
-  bool range_tolerance_set = false;  ///< the user set ~range_tolerance (see withGridTolerances())
-  int max_candidates = 10;           ///< ~max_candidates
-  int threads = 0;                   ///< ~threads; 0 = all cores
-  std::string cache_dir;             ///< ~cache_dir (expanded); empty = no disk cache
-  int max_boxes = 20000000;          ///< ~max_boxes: adaptive engine budget
-  double deadline = 0.0;             ///< ~deadline [s]: adaptive engine budget per call; 0 = none
+  double uniqueness_distance = 0.1;      ///< ~uniqueness_distance [m]
+  double uniqueness_angle = 0.1;         ///< ~uniqueness_angle [rad]
+  double range_tolerance = 0.02;         ///< ~range_tolerance [m]
+  bool range_tolerance_set = false;      ///< the user set ~range_tolerance (see withGridTolerances())
+  int max_candidates = 10;               ///< ~max_candidates
+  int threads = 0;                       ///< ~threads; 0 = all cores
+  std::string cache_dir;                 ///< ~cache_dir (expanded); empty = no disk cache
+  int max_boxes = 20000000;              ///< ~max_boxes: adaptive engine budget
+  double deadline = 0.0;                 ///< ~deadline [s]: adaptive engine budget per call; 0 = none
 };
 
 /**

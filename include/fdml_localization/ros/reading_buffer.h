@@ -8,7 +8,7 @@
  */
 #pragma once
 
-#include "fdml_localization/core/localizer.h"
+#include "fdml_localization/core/localization/localizer.h"
 
 #include <cstdint>
 #include <deque>
@@ -23,29 +23,29 @@ namespace fdml_localization
 /// Stable drop-reason identifiers (reported in LocalizationResult.drop_reasons and diagnostics).
 namespace drop_reason
 {
-constexpr const char* kNanRange = "nan_range";                     ///< range is NaN
-constexpr const char* kNegativeInfinity = "negative_infinity";     ///< -inf: too close (REP-117)
-constexpr const char* kNegativeRange = "negative_range";           ///< finite range < 0
-constexpr const char* kBelowMinRange = "below_min_range";          ///< range < min_range
-constexpr const char* kAboveMaxRange = "above_max_range";          ///< finite range > max_range
-constexpr const char* kInvalidLimits = "invalid_limits";           ///< min/max_range NaN, max <= 0 or max < min
-constexpr const char* kEmptyFrameId = "empty_frame_id";            ///< header.frame_id is empty
-constexpr const char* kZeroStamp = "zero_stamp";                   ///< header.stamp is 0 (unusable with odometry)
-constexpr const char* kStampBackwards = "stamp_backwards";         ///< older than the last reading of its frame
-constexpr const char* kUnknownFrame = "unknown_frame";             ///< frame never appeared on tf in time
+constexpr const char* kNanRange = "nan_range";                          ///< range is NaN
+constexpr const char* kNegativeInfinity = "negative_infinity";          ///< -inf: too close (REP-117)
+constexpr const char* kNegativeRange = "negative_range";                ///< finite range < 0
+constexpr const char* kBelowMinRange = "below_min_range";               ///< range < min_range
+constexpr const char* kAboveMaxRange = "above_max_range";               ///< finite range > max_range
+constexpr const char* kInvalidLimits = "invalid_limits";                ///< min/max_range NaN, max <= 0 or max < min
+constexpr const char* kEmptyFrameId = "empty_frame_id";                 ///< header.frame_id is empty
+constexpr const char* kZeroStamp = "zero_stamp";                        ///< header.stamp is 0 (unusable with odometry)
+constexpr const char* kStampBackwards = "stamp_backwards";              ///< older than the last reading of its frame
+constexpr const char* kUnknownFrame = "unknown_frame";                  ///< frame never appeared on tf in time
 constexpr const char* kTransformUnavailable = "transform_unavailable";  ///< no tf at the stamp in time
-constexpr const char* kBufferOverflow = "buffer_overflow";         ///< too many readings waiting for tf
+constexpr const char* kBufferOverflow = "buffer_overflow";              ///< too many readings waiting for tf
 }  // namespace drop_reason
 
 /// A reading as received, before its transforms are known.
 struct TimedReading
 {
-  std::string frame_id;    ///< sensor frame (the Range/LaserScan header frame)
-  std::int64_t stamp = 0;  ///< acquisition time [ns] (integer, so tf lookups hit stamps exactly)
-  core::Pose2 beam;        ///< the beam's pose in the sensor frame (a LaserScan beam: (0, 0, angle))
+  std::string frame_id;           ///< sensor frame (the Range/LaserScan header frame)
+  std::int64_t stamp = 0;         ///< acquisition time [ns] (integer, so tf lookups hit stamps exactly)
+  core::Pose2 beam;               ///< the beam's pose in the sensor frame (a LaserScan beam: (0, 0, angle))
   double range = core::kInf;      ///< [m]; +inf = no return
   double max_range = core::kInf;  ///< [m]
-  double received = 0.0;   ///< arrival time on the node's clock [s] (starts the transform wait)
+  double received = 0.0;          ///< arrival time on the node's clock [s] (starts the transform wait)
 };
 
 /// A reading with its poses in the odometry frame, both at the reading's own stamp.
@@ -108,7 +108,10 @@ public:
   /// Counts a reading dropped before it reached the buffer (e.g. a NaN range).
   void countDrop(const std::string& reason, std::uint64_t count = 1);
   /// Counts a received reading (valid or not), for statistics.
-  void countReceived(std::uint64_t count = 1) { received_ += count; }
+  void countReceived(std::uint64_t count = 1)
+  {
+    received_ += count;
+  }
 
   /**
    * @brief Resolves the queued readings whose transforms are available now, in arrival order;
@@ -131,22 +134,40 @@ public:
   /// On-request mode: drops every buffered reading and arms one batch of k fresh readings.
   void requestBatch();
   /// True while an on-request batch is armed but not yet taken.
-  bool batchRequested() const { return requested_; }
+  bool batchRequested() const
+  {
+    return requested_;
+  }
 
   /// Drops every buffered reading (not counted as drops; used by relocalization).
   void clear();
 
-  std::uint64_t received() const { return received_; }
+  std::uint64_t received() const
+  {
+    return received_;
+  }
   std::uint64_t dropped() const;
-  const std::map<std::string, std::uint64_t>& dropCounts() const { return drops_; }
-  std::size_t pendingCount() const { return pending_.size(); }
-  std::size_t resolvedCount() const { return resolved_.size(); }
-  const Options& options() const { return options_; }
+  const std::map<std::string, std::uint64_t>& dropCounts() const
+  {
+    return drops_;
+  }
+  std::size_t pendingCount() const
+  {
+    return pending_.size();
+  }
+  std::size_t resolvedCount() const
+  {
+    return resolved_.size();
+  }
+  const Options& options() const
+  {
+    return options_;
+  }
 
 private:
   Options options_;
-  std::deque<TimedReading> pending_;      ///< waiting for transforms, arrival order
-  std::deque<ResolvedReading> resolved_;  ///< ready, arrival order
+  std::deque<TimedReading> pending_;                ///< waiting for transforms, arrival order
+  std::deque<ResolvedReading> resolved_;            ///< ready, arrival order
   std::map<std::string, std::int64_t> last_stamp_;  ///< newest accepted stamp per frame [ns]
   std::map<std::string, std::uint64_t> drops_;
   std::uint64_t received_ = 0;

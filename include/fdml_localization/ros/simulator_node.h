@@ -15,7 +15,7 @@
 #pragma once
 
 #include "fdml_localization/Kidnap.h"
-#include "fdml_localization/core/simulation.h"
+#include "fdml_localization/simulation/simulation.h"
 
 #include <geometry_msgs/Twist.h>
 #include <ros/ros.h>
@@ -47,7 +47,10 @@ public:
   bool init(std::vector<std::string>* errors);
 
   /// The simulation (for introspection).
-  const core::Simulation& simulation() const { return *sim_; }
+  const core::Simulation& simulation() const
+  {
+    return *sim_;
+  }
 
 private:
   void onTimer(const ros::WallTimerEvent& event);
@@ -89,8 +92,8 @@ private:
   tf2_ros::StaticTransformBroadcaster static_broadcaster_;
   ros::WallTimer timer_;
 
-  ros::Time base_stamp_;        ///< stamp of simulated time 0
-  ros::WallTime wall_start_;    ///< wall time of simulated time 0
+  ros::Time base_stamp_;      ///< stamp of simulated time 0
+  ros::WallTime wall_start_;  ///< wall time of simulated time 0
   double next_marker_time_ = 0.0;
   std::vector<core::SimReading> last_readings_;  ///< per sensor, for the ray markers
   std::size_t marker_count_ = 0;

@@ -1,0 +1,139 @@
+/**
+ * @file adaptive_search.h
+ * @brief Branch and prune over boxes of poses in R^2 x S^1 (the adaptive engine's search).
+ *
+ * For a pose box B = [x0,x1] x [y0,y1] x [t0,t1] and a reading (g, d), every hit point
+ * (x, y) + R(theta) v, v = (gx + d cos g_theta, gy + d sin g_theta), lies in the exact bounding
+ * box of the arc R(theta) v over [t0, t1] plus [x0,x1] x [y0,y1], inflated by the range
+ * tolerance. When no map edge meets that box, the reading cannot be explained anywhere in B.
+ * A box survives while at least k' readings may be explained, so the box holding the truth is
+ * never pruned (no exceptions near discontinuities of h), and the work grows with the answer.
+ */
+#pragma once
+
+#include "fdml_localization/core/localization/voxel/box_occupancy.h"
+#include "fdml_localization/core/localization/localizer.h"
+
+#include <chrono>
+#include <cstdint>
+#include <vector>
+
+namespace fdml_localization
+{
+namespace core
+{
+/// A box of poses [m], [rad]. theta may extend past +-pi; it is periodic.
+struct PoseBox
+{
+  double x0 = 0.0, x1 = 0.0;
+  double y0 = 0.0, y1 = 0.0;
+  double t0 = 0.0, t1 = 0.0;
+
+  Pose2 centre() const
+  {
+    return Pose2(0.5 * (x0 + x1), 0.5 * (y0 + y1), wrapAngle(0.5 * (t0 + t1)));
+  }
+};
+
+/// A surviving leaf box, with the number of readings that may be explained in it.
+struct LeafBox
+{
+  PoseBox box;
+  int count = 0;                        ///< readings that pass the box test
+  std::uint64_t mask = 0;               ///< bit i set when reading i passes (first 64 readings)
+  std::int64_t ix = 0, iy = 0, it = 0;  ///< integer cell of the leaf at the finest level
+};
+
+/// Options of the box search.
+struct AdaptiveSearchOptions
+{
+  double cell_xy = 0.05;          ///< leaf size in x and y [m]
+  double cell_theta = 0.05;       ///< leaf size in theta [rad]
+  int min_count = 3;              ///< k': a box needs this many explainable readings
+  double range_tolerance = 0.02;  ///< tau [m]
+  long max_boxes = 20000000;      ///< budget of boxes tested over the whole search
+  double deadline = 0.0;          ///< wall-time budget [s]; 0 = none
+  int threads = 0;                ///< OpenMP threads; 0 = all
+  /// Lowest k' a resumed search may be asked for (AdaptiveSearch::run); boxes pruned with an
+  /// upper bound of at least this many readings are kept aside for a later, lower k'.
+  int floor_count = 0;
+  /// Levels with at most this many boxes are tested on one thread (no barrier cost).
+  long parallel_threshold = 2000;
+};
+
+/// The outcome of a box search.
+struct AdaptiveSearchResult
+{
+  std::vector<LeafBox> leaves;        ///< surviving boxes at the finest level
+  std::vector<long> boxes_per_level;  ///< boxes kept at each level (level 0 = the root grid)
+  long boxes_tested = 0;
+  bool truncated = false;  ///< a budget was reached; leaves are from the last full level
+};
+
+/// The conservative per-reading box test (exposed for tests): false only when the reading
+/// provably cannot be explained by any pose in @p box.
+bool readingMayExplain(const MapRayCaster& map, const Reading& reading, const PoseBox& box, double range_tolerance);
+
+/// Exact bounding box of the arc R(theta) v for theta in [t0, t1] (t1 - t0 <= 2 pi).
+Box2 rotatedArcBounds(const Vec2& v, double t0, double t1);
+
+/// Runs the search over the map's bounding box x [-pi, pi).
+AdaptiveSearchResult adaptiveSearch(const MapRayCaster& map, const std::vector<Reading>& readings,
+                                    const AdaptiveSearchOptions& options);
+
+/// The same search with a prebuilt occupancy grid of the map (see AdaptiveSearch).
+AdaptiveSearchResult adaptiveSearch(const MapRayCaster& map, const BoxOccupancy& occupancy,
+                                    const std::vector<Reading>& readings, const AdaptiveSearchOptions& options);
+
+/**
+ * @brief A resumable search for maximum consensus: run(k1) keeps the leaves with at least k1
+ *        explainable readings; a later run(k2), k2 < k1, adds exactly the leaves with k2 <= count
+ *        < k1 by resuming from the boxes the earlier runs set aside (never testing a box twice at
+ *        the same k'), so lowering k' step by step costs one search, not one per step.
+ */
+class AdaptiveSearch
+{
+public:
+  /// @p occupancy and @p map must outlive the search; options.floor_count bounds later run()s.
+  AdaptiveSearch(const MapRayCaster& map, const BoxOccupancy& occupancy, std::vector<Reading> readings,
+                 const AdaptiveSearchOptions& options);
+
+  /// Searches down to the leaves for k' = @p min_count (>= options.floor_count, not above the
+  /// previous run's) and returns all leaves found so far, with counts >= min_count.
+  const AdaptiveSearchResult& run(int min_count);
+  const AdaptiveSearchResult& result() const
+  {
+    return result_;
+  }
+
+private:
+  struct Node
+  {
+    std::int32_t ix, iy, it;  ///< index of the node's first leaf cell along each axis
+    std::int32_t count;       ///< readings that pass (an upper bound for set-aside nodes)
+    std::uint64_t mask;
+  };
+  PoseBox boxOf(const Node& n, int level) const;
+  /// Tests one node against @p min_count; fills count (exact when kept) and mask.
+  bool test(Node& n, int level, int min_count) const;
+  void prepareArcs(int level);
+
+  const MapRayCaster& map_;
+  const BoxOccupancy& occupancy_;
+  std::vector<Reading> readings_;
+  AdaptiveSearchOptions options_;
+  std::int64_t nx_ = 1, ny_ = 1, nt_ = 1;
+  double cell_t_ = 1.0;
+  int lx_ = 0, ly_ = 0, lt_ = 0, levels_ = 0;
+  std::vector<std::vector<Node>> set_aside_;  ///< per level
+  std::vector<std::vector<Box2>> arcs_;       ///< per level: [theta node * readings * 2] hit / sensor arcs
+  AdaptiveSearchResult result_;
+  bool started_ = false;
+  bool finished_ = false;  ///< a budget cut the search; no more runs
+  using Clock = std::chrono::steady_clock;
+  Clock::time_point start_;
+  double elapsed_ = 0.0;
+};
+
+}  // namespace core
+}  // namespace fdml_localization

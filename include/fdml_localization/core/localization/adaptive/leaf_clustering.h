@@ -1,0 +1,41 @@
+/**
+ * @file leaf_clustering.h
+ * @brief Clusters of the adaptive search's surviving leaves: connected components and regional
+ *        maxima on the leaf lattice (26 neighbours, periodic in theta), each giving seeds.
+ */
+#pragma once
+
+#include "fdml_localization/core/localization/adaptive/adaptive_search.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace fdml_localization
+{
+namespace core
+{
+/// A cluster of surviving leaves: its peak-count plateau gives one seed.
+struct LeafCluster
+{
+  Pose2 centroid;           ///< mean x, y [m], circular mean theta [rad] of the plateau leaves
+  std::size_t representative = 0;  ///< index (into the leaves) of the plateau leaf nearest the centroid
+  std::size_t size = 0;     ///< leaves in the whole connected component
+  int peak_count = 0;
+  std::vector<std::size_t> members;  ///< plateau leaves (leafMaxima only), ascending
+};
+
+/**
+ * @brief Connected components (26 neighbours on the leaf lattice, periodic in theta with
+ *        @p theta_cells cells) of the leaves with count >= @p level; each component yields one
+ *        cluster per connected plateau of its peak count (peaks are never averaged together).
+ */
+std::vector<LeafCluster> clusterLeaves(const std::vector<LeafBox>& leaves, int level, std::int64_t theta_cells);
+
+/**
+ * @brief Regional maxima at exactly @p level: connected plateaus (26 neighbours, periodic theta)
+ *        of the leaves with count == level that touch no leaf with a higher count; largest first.
+ */
+std::vector<LeafCluster> leafMaxima(const std::vector<LeafBox>& leaves, int level, std::int64_t theta_cells);
+
+}  // namespace core
+}  // namespace fdml_localization

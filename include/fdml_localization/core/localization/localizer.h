@@ -1,0 +1,188 @@
+/**
+ * @file localizer.h
+ * @brief The robust localizer: from k range readings with known relative sensor poses g_i,
+ *        find every robot pose q in the map that explains at least k' of them.
+ *
+ * One API, two engines: the voxel engine (the paper's voxel clouds, with counting, automatic
+ * k', inlier masks and continuous polish) and the adaptive engine (branch and prune over pose
+ * boxes). Construct once per map (the voxel engine's distance table is built or loaded from
+ * the cache lazily on the first call, or eagerly by prepare()), then call localize() many times.
+ */
+#pragma once
+
+#include "fdml_localization/core/geometry/ray_caster.h"
+
+#include <Eigen/Core>
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace fdml_localization
+{
+namespace core
+{
+/// One range reading.
+struct Reading
+{
+  /// Sensor pose at the reading, in the base frame at the batch's first reading: g_i.
+  Pose2 offset;
+  /// Measured distance [m]; +inf = no return within max_range.
+  double range = kInf;
+  /// The sensor's maximum range [m]; +inf when unknown.
+  double max_range = kInf;
+};
+
+enum class Method
+{
+  Robust,   ///< counting, automatic or fixed k', inlier masks, polish (ours)
+  Paper,    ///< the paper exactly: fixed k', component centres, eps filter, delta uniqueness
+  Baseline  ///< FDML: k' = k, no polish
+};
+
+enum class Engine
+{
+  Voxel,    ///< uniform n x n x n_theta grid (the paper's voxel clouds)
+  Adaptive  ///< branch and prune over boxes of poses
+};
+
+const char* toString(Method method);
+const char* toString(Engine engine);
+/// Parses "robust" / "paper" / "baseline"; throws std::invalid_argument otherwise.
+Method parseMethod(const std::string& text);
+/// Parses "voxel" / "adaptive"; throws std::invalid_argument otherwise.
+Engine parseEngine(const std::string& text);
+
+/// Largest resolution of the voxel engine (its table holds n x n x n_theta samples).
+constexpr int kMaxVoxelResolution = 1024;
+/// Largest resolution of the adaptive engine (1 mm cells over a 100 m map).
+constexpr int kMaxAdaptiveResolution = 100000;
+
+/// Localizer options. validate() lists every out-of-range value.
+struct LocalizerOptions
+{
+  Engine engine = Engine::Voxel;
+  Method method = Method::Robust;
+  int resolution = 100;               ///< cells along the map's longer side, in [16, 1024] (voxel)
+                                      ///< or [16, 100000] (adaptive)
+  int theta_resolution = 0;           ///< cells in theta; 0 = resolution
+  int min_inliers = 0;                ///< k' in [3, k]; 0 = automatic (maximum consensus)
+  double agreement_tolerance = 0.05;  ///< eps [m]: a reading agrees when |h - d| < eps
+  double uniqueness_distance = 0.1;   ///< delta: candidates closer than this [m] ...
+  double uniqueness_angle = 0.1;      ///< ... and this [rad] are duplicates
+  double range_tolerance = 0.02;      ///< tau: sensor noise band [m] used by the preimages
+  int max_candidates = 10;            ///< at most this many candidates are returned (>= 1)
+  int threads = 0;                    ///< OpenMP threads; 0 = all cores
+  std::string cache_dir;              ///< distance-table cache folder; empty = no disk cache
+  // Adaptive engine budget.
+  long max_boxes = 20000000;  ///< stop subdividing after this many boxes (>= 1000)
+  double deadline = 0.0;      ///< wall-time budget per call [s]; 0 = none
+};
+
+/// Every problem with the options, each naming the option and its allowed range.
+std::vector<std::string> validate(const LocalizerOptions& options);
+
+/// Thrown by localize() for unusable input (NaN or negative ranges, too few readings, ...).
+class InvalidInput : public std::invalid_argument
+{
+public:
+  using std::invalid_argument::invalid_argument;
+};
+
+/**
+ * @brief Checks a batch against the options: at least 3 and at most 255 readings, finite
+ *        offsets, ranges >= 0 and not NaN, a finite max_range > 0 for every no-return reading,
+ *        no finite range beyond its max_range, and k' <= k.
+ * @throws InvalidInput naming the first problem (and the reading's index)
+ */
+void validateReadings(const std::vector<Reading>& readings, const LocalizerOptions& options);
+
+/// One candidate pose.
+struct Candidate
+{
+  Pose2 pose;                     ///< robot base pose in the map frame at the first reading
+  std::vector<bool> inlier_mask;  ///< per reading: agrees with the static map
+  int inliers = 0;
+  /// Readings measured longer than the map allows at this pose (beyond eps), or with no return
+  /// where the map has a wall in range: no unknown obstacle explains them (they only shorten
+  /// readings), so each counts against the pose (ranking: inliers - contradicted first).
+  int contradicted = 0;
+  double rms_residual = 0.0;                             ///< over the inliers [m]
+  double support = 0.0;                                  ///< voxels (or boxes) of the component it came from
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< of (x, y, theta) from the polish
+};
+
+/// Wall time of each stage [s].
+struct StageTimes
+{
+  double table = 0.0;  ///< distance table build or cache load (first call only)
+  double preimages = 0.0;
+  double count = 0.0;
+  double components = 0.0;
+  double verification = 0.0;
+  double polish = 0.0;
+  double total = 0.0;
+};
+
+/// The outcome of one localize() call.
+struct Result
+{
+  std::vector<Candidate> candidates;  ///< best first: see betterCandidate() (candidate_refinement.h)
+  int readings_used = 0;
+  int min_inliers_used = 0;  ///< k' actually used
+  bool truncated = false;    ///< a search budget was reached (adaptive engine)
+  StageTimes times;
+  std::vector<long> boxes_per_level;  ///< adaptive engine: boxes kept at each level
+  Engine engine = Engine::Voxel;
+  Method method = Method::Robust;
+};
+
+/// The engine interface behind Localizer.
+class LocalizerEngine
+{
+public:
+  virtual ~LocalizerEngine() = default;
+  virtual void prepare() = 0;
+  virtual Result localize(const std::vector<Reading>& readings) = 0;
+};
+
+/**
+ * @brief The public entry point. Not thread-safe: use one Localizer per thread
+ *        (each call is internally parallel with OpenMP).
+ */
+class Localizer
+{
+public:
+  /// @throws std::invalid_argument listing every problem of @p options, or for an empty map.
+  Localizer(std::shared_ptr<const MapRayCaster> map, const LocalizerOptions& options);
+  ~Localizer();
+
+  /// Builds or loads precomputed tables now instead of on the first localize().
+  void prepare();
+
+  /// @throws InvalidInput for unusable readings (the message names the problem).
+  Result localize(const std::vector<Reading>& readings);
+
+  const LocalizerOptions& options() const
+  {
+    return options_;
+  }
+  const MapRayCaster& map() const
+  {
+    return *map_;
+  }
+  /// The engine behind this localizer (for diagnostics and tests).
+  LocalizerEngine& engine()
+  {
+    return *engine_;
+  }
+
+private:
+  std::shared_ptr<const MapRayCaster> map_;
+  LocalizerOptions options_;
+  std::unique_ptr<LocalizerEngine> engine_;
+};
+
+}  // namespace core
+}  // namespace fdml_localization

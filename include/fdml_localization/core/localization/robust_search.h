@@ -1,0 +1,137 @@
+/**
+ * @file candidate_refinement.h
+ * @brief The later stages every engine shares: exact-ray-cast verification of a pose
+ *        (inlier mask, RMS residual), the continuous polish (Levenberg-Marquardt on
+ *        (x, y, theta) with analytic derivatives of the exact ray cast, covariance estimate),
+ *        and duplicate removal and ranking of candidates.
+ */
+#pragma once
+
+#include "fdml_localization/core/localization/localizer.h"
+
+#include <Eigen/Core>
+
+#include <vector>
+
+namespace fdml_localization
+{
+namespace core
+{
+/// The agreement of one pose with a batch of readings, by exact ray casts on the polygon.
+struct PoseEvaluation
+{
+  std::vector<bool> inlier_mask;  ///< per reading: agrees within eps
+  std::vector<double> residuals;  ///< h(q (+) g_i) - d_i [m]; NaN for no-return readings or a
+                                  ///< sensor outside free space
+  int inliers = 0;
+  /// Readings the map contradicts: measured longer than h + eps, or no return where the map has
+  /// a wall within max_range - eps. Unknown obstacles only shorten readings, so none of these
+  /// is explained by one.
+  int contradicted = 0;
+  double rms = 0.0;  ///< RMS of the residuals of the finite-range inliers [m]
+};
+
+/**
+ * @brief Verifies @p pose: reading i agrees when its sensor position q (+) g_i is in free
+ *        space and |h(q (+) g_i) - d_i| < eps, or, for a no-return reading (d_i = +inf),
+ *        when h(q (+) g_i) > max_range_i - eps. A reading the map contradicts (see
+ *        PoseEvaluation::contradicted) counts against the pose in the ranking.
+ * @param eps agreement tolerance [m]
+ */
+PoseEvaluation evaluatePose(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings,
+                            double eps);
+
+/// Result of polishPose().
+struct PolishOutcome
+{
+  Pose2 pose;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< of (x, y, theta)
+  int iterations = 0;
+};
+
+/**
+ * @brief Nonlinear least squares on the finite-range readings selected by @p use, from
+ *        @p start: Levenberg-Marquardt on (x, y, theta) with the analytic derivative of the exact
+ *        ray cast (the hit edge's normal). A ray that leaves free space or misses costs a
+ *        constant penalty, so the polish does not walk through walls.
+ * @param robust_scale Cauchy loss scale [m]; 0 = plain least squares
+ * @param noise_sigma lower bound on the residual standard deviation used for the covariance [m]
+ */
+PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std::vector<Reading>& readings,
+                         const std::vector<bool>& use, double robust_scale, int max_iterations, double noise_sigma);
+
+/// Settings of refineSeed().
+struct RefinementSettings
+{
+  double agreement_tolerance = 0.05;      ///< eps [m]
+  double robust_scale = 0.1;              ///< Cauchy scale of the first polish [m] (about the seed's error)
+  double seed_position_error = 0.1;       ///< how far the seed may be from the optimum in x, y [m]
+  double seed_angle_error = 0.05;         ///< ... and in theta [rad]
+  double noise_sigma = 0.01;              ///< lower bound on the range noise for the covariance [m]
+  int max_iterations = 30;                ///< per polish
+  int max_rounds = 3;                     ///< re-polish on the new inlier set at most this often
+  int max_escapes = 3;                    ///< leave-one-out rounds to escape a false minimum
+  int escape_tries = 4;                   ///< readings tried per leave-one-out round
+  int escape_min_inliers = 3;             ///< only candidates with this many inliers try to escape
+  int target_inliers = 3;                 ///< below this many inliers, try hypotheses without the
+                                          ///< readings most shortened at the seed (obstacle hits)
+  int max_dropped_shortened = 3;          ///< ... leaving out at most this many
+  int local_search_cells = 0;             ///< below target_inliers, also search (2m+1)^3 poses
+                                          ///< around the seed; 0 = no local search
+  double local_search_step = 0.05;        ///< lattice step of that search in x, y [m]
+  double local_search_angle_step = 0.02;  ///< ... and in theta [rad]
+};
+
+/**
+ * @brief From a seed pose and a hypothesis of which readings it explains, the best pose found:
+ *        1. annealed robust polishes (Cauchy scale shrinking to eps) on the hypothesis, on the
+ *           hypothesis without the readings whose rays pass so close to a map vertex that the
+ *           seed's error could put them across an occlusion edge, and, while fewer than
+ *           target_inliers readings agree, without the 1, 2, 3 readings most shortened at the
+ *           seed (unknown obstacles only shorten readings);
+ *        2. optionally a lattice search around the seed (local_search_cells);
+ *        3. rounds of verification and plain polish on the eps-inliers while the consensus
+ *           improves (more inliers, then lower RMS);
+ *        4. leave-one-out re-polishes (the worst reading, the ones passing nearest a vertex) to
+ *           escape the false minima that corners create in the piecewise-smooth cost.
+ *        Never returns a pose worse than the seed.
+ */
+Candidate refineSeed(const MapRayCaster& map, const Pose2& seed, const std::vector<Reading>& readings,
+                     const std::vector<bool>& hypothesis, const RefinementSettings& settings);
+
+/**
+ * @brief For each reading, how close its ray from @p pose passes to a map vertex, relative to
+ *        the pose's uncertainty: min over vertices of (perpendicular distance - t * angle_error),
+ *        t being the vertex's distance along the ray [m]. Small values mark readings whose ray may
+ *        cross an occlusion edge within the uncertainty (their h is discontinuous there).
+ *        +inf for no-return readings and sensors outside free space.
+ */
+std::vector<double> vertexMargins(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings,
+                                  double angle_error);
+
+/// A candidate at @p pose, verified but not polished.
+Candidate verifiedCandidate(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings,
+                            double eps);
+
+/// Net consensus of a candidate: inliers minus the readings the map contradicts at its pose.
+inline int netConsensus(const Candidate& c)
+{
+  return c.inliers - c.contradicted;
+}
+
+/**
+ * @brief Ranking order: the larger net consensus (inliers - contradicted) first, then fewer
+ *        contradicted readings, then lower RMS residual. Without contradicted readings this is
+ *        "most inliers, then lowest RMS".
+ */
+bool betterCandidate(const Candidate& a, const Candidate& b);
+
+/**
+ * @brief Sorts best first and drops every candidate closer than (@p distance [m], @p angle
+ *        [rad]) to a better one kept before it; keeps at most @p max_candidates.
+ */
+std::vector<Candidate> rankAndDeduplicate(std::vector<Candidate> candidates, double distance, double angle,
+                                          int max_candidates);
+
+}  // namespace core
+}  // namespace fdml_localization

@@ -1,0 +1,29 @@
+/**
+ * @file text_parsing.h
+ * @brief Strict number parsing for command-line tools and text files: the whole text must be
+ *        the number (surrounding blanks allowed), and errors name what was being parsed.
+ */
+#pragma once
+
+#include <string>
+
+namespace fdml_localization
+{
+namespace core
+{
+/// @p text without leading and trailing white space (space, tab, CR, LF, FF, VT).
+std::string trim(const std::string& text);
+
+/**
+ * @brief Parses @p text as a number.
+ * @param what names the value in the error (a flag, or "FILE:LINE: field")
+ * @param allow_infinite accept "inf" / "-inf" (NaN is never accepted)
+ * @throws std::invalid_argument "WHAT: 'TEXT' is not a (finite) number"
+ */
+double parseNumber(const std::string& text, const std::string& what, bool allow_infinite = false);
+
+/// Parses @p text as an integer in [-1e9, 1e9]. @throws std::invalid_argument naming @p what.
+int parseInteger(const std::string& text, const std::string& what);
+
+}  // namespace core
+}  // namespace fdml_localization

@@ -1,0 +1,89 @@
+#include "fdml_localization/core/localization/adaptive/adaptive_search.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace fdml_localization
+{
+namespace core
+{
+namespace
+{
+/// True when a box that meets no map edge lies outside free space (test its centre).
+bool outsideFreeSpace(const MapRayCaster& map, const Box2& box)
+{
+  return !map.grid().anySegmentInBox(box) && !map.isFree(0.5 * (box.min + box.max));
+}
+
+Box2 sweep(const Box2& positions, const Vec2& v, double t0, double t1, double inflate)
+{
+  const Box2 arc = rotatedArcBounds(v, t0, t1);
+  Box2 out;
+  out.min = positions.min + arc.min - Vec2(inflate, inflate);
+  out.max = positions.max + arc.max + Vec2(inflate, inflate);
+  return out;
+}
+
+}  // namespace
+
+Box2 rotatedArcBounds(const Vec2& v, double t0, double t1)
+{
+  Box2 box;
+  const double r = v.norm();
+  if (r == 0.0)
+  {
+    box.extend(Vec2::Zero());
+    return box;
+  }
+  const double phi = std::atan2(v.y(), v.x());
+  const double a0 = t0 + phi;
+  const double a1 = t1 + phi;
+  box.extend(Vec2(r * std::cos(a0), r * std::sin(a0)));
+  box.extend(Vec2(r * std::cos(a1), r * std::sin(a1)));
+  // Axis extremes at multiples of pi/2 inside [a0, a1].
+  for (double k = std::ceil(a0 / (0.5 * kPi)); k * 0.5 * kPi <= a1; k += 1.0)
+  {
+    const double a = k * 0.5 * kPi;
+    box.extend(Vec2(r * std::cos(a), r * std::sin(a)));
+  }
+  return box;
+}
+
+bool readingMayExplain(const MapRayCaster& map, const Reading& reading, const PoseBox& box, double range_tolerance)
+{
+  Box2 positions;
+  positions.extend(Vec2(box.x0, box.y0));
+  positions.extend(Vec2(box.x1, box.y1));
+  const Pose2& g = reading.offset;
+  // The sensor must be in free space somewhere in the box (for a sensor at the base origin the
+  // caller's robot-position test already says so).
+  if ((g.x != 0.0 || g.y != 0.0) && outsideFreeSpace(map, sweep(positions, Vec2(g.x, g.y), box.t0, box.t1, 0.0)))
+  {
+    return false;
+  }
+  if (!std::isfinite(reading.range))
+  {
+    return true;  // a no-return reading is only checked exactly, in verification
+  }
+  const Vec2 v(g.x + reading.range * std::cos(g.theta), g.y + reading.range * std::sin(g.theta));
+  return map.grid().anySegmentInBox(sweep(positions, v, box.t0, box.t1, range_tolerance));
+}
+
+AdaptiveSearchResult adaptiveSearch(const MapRayCaster& map, const std::vector<Reading>& readings,
+                                    const AdaptiveSearchOptions& options)
+{
+  const BoxOccupancy occupancy(map, options.cell_xy);
+  return adaptiveSearch(map, occupancy, readings, options);
+}
+
+AdaptiveSearchResult adaptiveSearch(const MapRayCaster& map, const BoxOccupancy& occupancy,
+                                    const std::vector<Reading>& readings, const AdaptiveSearchOptions& options)
+{
+  AdaptiveSearchOptions o = options;
+  o.floor_count = options.min_count;
+  AdaptiveSearch search(map, occupancy, readings, o);
+  return search.run(options.min_count);
+}
+
+}  // namespace core
+}  // namespace fdml_localization

@@ -1,0 +1,248 @@
+#include "fdml_localization/core/localization/adaptive/leaf_clustering.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <unordered_map>
+
+namespace fdml_localization
+{
+namespace core
+{
+namespace
+{
+/// Union-find over leaf indices.
+class DisjointSets
+{
+public:
+  explicit DisjointSets(std::size_t n) : parent_(n)
+  {
+    std::iota(parent_.begin(), parent_.end(), 0);
+  }
+  std::size_t find(std::size_t i)
+  {
+    while (parent_[i] != i)
+    {
+      parent_[i] = parent_[parent_[i]];
+      i = parent_[i];
+    }
+    return i;
+  }
+  void unite(std::size_t a, std::size_t b)
+  {
+    parent_[find(a)] = find(b);
+  }
+
+private:
+  std::vector<std::size_t> parent_;
+};
+
+std::uint64_t cellKey(std::int64_t ix, std::int64_t iy, std::int64_t it)
+{
+  return (static_cast<std::uint64_t>(ix) << 42) ^ (static_cast<std::uint64_t>(iy) << 21) ^
+         static_cast<std::uint64_t>(it);
+}
+
+/// Unites every pair of 26-neighbours among @p members (theta periodic).
+void uniteNeighbours(const std::vector<LeafBox>& leaves, const std::vector<std::size_t>& members,
+                     std::int64_t theta_cells, DisjointSets& sets)
+{
+  std::unordered_map<std::uint64_t, std::size_t> index;
+  index.reserve(members.size() * 2);
+  for (const std::size_t i : members)
+  {
+    index.emplace(cellKey(leaves[i].ix, leaves[i].iy, leaves[i].it), i);
+  }
+  for (const std::size_t i : members)
+  {
+    const LeafBox& l = leaves[i];
+    for (int dt = -1; dt <= 1; ++dt)
+    {
+      const std::int64_t t = ((l.it + dt) % theta_cells + theta_cells) % theta_cells;
+      for (int dy = -1; dy <= 1; ++dy)
+      {
+        for (int dx = -1; dx <= 1; ++dx)
+        {
+          if (l.ix + dx < 0 || l.iy + dy < 0)
+          {
+            continue;
+          }
+          const auto found = index.find(cellKey(l.ix + dx, l.iy + dy, t));
+          if (found != index.end())
+          {
+            sets.unite(i, found->second);
+          }
+        }
+      }
+    }
+  }
+}
+
+/// Mean position and circular-mean heading of the leaves' centres; the leaf nearest to it.
+LeafCluster plateauCluster(const std::vector<LeafBox>& leaves, const std::vector<std::size_t>& members)
+{
+  LeafCluster c;
+  double sx = 0.0, sy = 0.0, ss = 0.0, sc = 0.0;
+  for (const std::size_t i : members)
+  {
+    const Pose2 p = leaves[i].box.centre();
+    sx += p.x;
+    sy += p.y;
+    ss += std::sin(p.theta);
+    sc += std::cos(p.theta);
+  }
+  const double n = static_cast<double>(members.size());
+  c.centroid = Pose2(sx / n, sy / n, std::atan2(ss, sc));
+  double best = kInf;
+  for (const std::size_t i : members)
+  {
+    const Pose2 p = leaves[i].box.centre();
+    const double d =
+        (p.position() - c.centroid.position()).squaredNorm() + std::pow(angleDiff(p.theta, c.centroid.theta), 2);
+    if (d < best)
+    {
+      best = d;
+      c.representative = i;
+    }
+  }
+  return c;
+}
+}  // namespace
+
+std::vector<LeafCluster> clusterLeaves(const std::vector<LeafBox>& leaves, int level, std::int64_t theta_cells)
+{
+  std::vector<std::size_t> members;
+  for (std::size_t i = 0; i < leaves.size(); ++i)
+  {
+    if (leaves[i].count >= level)
+    {
+      members.push_back(i);
+    }
+  }
+  DisjointSets components(leaves.size());
+  uniteNeighbours(leaves, members, theta_cells, components);
+  std::unordered_map<std::size_t, std::vector<std::size_t>> by_root;
+  for (const std::size_t i : members)
+  {
+    by_root[components.find(i)].push_back(i);
+  }
+  std::vector<LeafCluster> clusters;
+  for (auto& entry : by_root)
+  {
+    const std::vector<std::size_t>& component = entry.second;
+    int peak = 0;
+    for (const std::size_t i : component)
+    {
+      peak = std::max(peak, leaves[i].count);
+    }
+    std::vector<std::size_t> plateau;
+    for (const std::size_t i : component)
+    {
+      if (leaves[i].count == peak)
+      {
+        plateau.push_back(i);
+      }
+    }
+    DisjointSets plateaus(leaves.size());
+    uniteNeighbours(leaves, plateau, theta_cells, plateaus);
+    std::unordered_map<std::size_t, std::vector<std::size_t>> parts;
+    for (const std::size_t i : plateau)
+    {
+      parts[plateaus.find(i)].push_back(i);
+    }
+    for (auto& part : parts)
+    {
+      LeafCluster c = plateauCluster(leaves, part.second);
+      c.size = component.size();
+      c.peak_count = peak;
+      clusters.push_back(c);
+    }
+  }
+  // Deterministic order: highest peak, then largest component, then position.
+  std::sort(clusters.begin(), clusters.end(), [](const LeafCluster& a, const LeafCluster& b) {
+    if (a.peak_count != b.peak_count)
+    {
+      return a.peak_count > b.peak_count;
+    }
+    if (a.size != b.size)
+    {
+      return a.size > b.size;
+    }
+    return a.representative < b.representative;
+  });
+  return clusters;
+}
+
+std::vector<LeafCluster> leafMaxima(const std::vector<LeafBox>& leaves, int level, std::int64_t theta_cells)
+{
+  std::unordered_map<std::uint64_t, std::size_t> index;
+  std::vector<std::size_t> plateau;
+  for (std::size_t i = 0; i < leaves.size(); ++i)
+  {
+    if (leaves[i].count >= level)
+    {
+      index.emplace(cellKey(leaves[i].ix, leaves[i].iy, leaves[i].it), i);
+    }
+    if (leaves[i].count == level)
+    {
+      plateau.push_back(i);
+    }
+  }
+  DisjointSets sets(leaves.size());
+  std::vector<char> dominated(leaves.size(), 0);
+  for (const std::size_t i : plateau)
+  {
+    const LeafBox& l = leaves[i];
+    for (int dt = -1; dt <= 1; ++dt)
+    {
+      const std::int64_t t = ((l.it + dt) % theta_cells + theta_cells) % theta_cells;
+      for (int dy = -1; dy <= 1; ++dy)
+      {
+        for (int dx = -1; dx <= 1; ++dx)
+        {
+          const auto found = index.find(cellKey(l.ix + dx, l.iy + dy, t));
+          if (l.ix + dx < 0 || l.iy + dy < 0 || found == index.end())
+          {
+            continue;
+          }
+          if (leaves[found->second].count > level)
+          {
+            dominated[i] = 1;
+          }
+          else
+          {
+            sets.unite(i, found->second);
+          }
+        }
+      }
+    }
+  }
+  std::unordered_map<std::size_t, std::vector<std::size_t>> parts;
+  for (const std::size_t i : plateau)
+  {
+    parts[sets.find(i)].push_back(i);
+  }
+  std::vector<LeafCluster> maxima;
+  for (auto& part : parts)
+  {
+    std::vector<std::size_t>& members = part.second;
+    if (std::any_of(members.begin(), members.end(), [&](std::size_t i) { return dominated[i] != 0; }))
+    {
+      continue;
+    }
+    std::sort(members.begin(), members.end());
+    LeafCluster c = plateauCluster(leaves, members);
+    c.size = members.size();
+    c.peak_count = level;
+    c.members = std::move(members);
+    maxima.push_back(std::move(c));
+  }
+  // Deterministic order: largest plateau first, then position.
+  std::sort(maxima.begin(), maxima.end(), [](const LeafCluster& a, const LeafCluster& b) {
+    return a.size != b.size ? a.size > b.size : a.representative < b.representative;
+  });
+  return maxima;
+}
+
+}  // namespace core
+}  // namespace fdml_localization

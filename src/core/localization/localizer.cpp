@@ -1,0 +1,232 @@
+#include "fdml_localization/core/localization/localizer.h"
+
+#include "fdml_localization/core/localization/adaptive/adaptive_engine.h"
+
+#include "fdml_localization/core/localization/voxel/voxel_engine.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace fdml_localization
+{
+namespace core
+{
+namespace
+{
+std::string number(double value)
+{
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+bool finitePose(const Pose2& p)
+{
+  return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.theta);
+}
+}  // namespace
+
+const char* toString(Method method)
+{
+  switch (method)
+  {
+    case Method::Robust:
+      return "robust";
+    case Method::Paper:
+      return "paper";
+    case Method::Baseline:
+      return "baseline";
+  }
+  return "unknown";
+}
+
+const char* toString(Engine engine)
+{
+  switch (engine)
+  {
+    case Engine::Voxel:
+      return "voxel";
+    case Engine::Adaptive:
+      return "adaptive";
+  }
+  return "unknown";
+}
+
+Method parseMethod(const std::string& text)
+{
+  if (text == "robust")
+  {
+    return Method::Robust;
+  }
+  if (text == "paper")
+  {
+    return Method::Paper;
+  }
+  if (text == "baseline")
+  {
+    return Method::Baseline;
+  }
+  throw std::invalid_argument("unknown method '" + text + "' (expected robust, paper or baseline)");
+}
+
+Engine parseEngine(const std::string& text)
+{
+  if (text == "voxel")
+  {
+    return Engine::Voxel;
+  }
+  if (text == "adaptive")
+  {
+    return Engine::Adaptive;
+  }
+  throw std::invalid_argument("unknown engine '" + text + "' (expected voxel or adaptive)");
+}
+
+std::vector<std::string> validate(const LocalizerOptions& o)
+{
+  std::vector<std::string> errors;
+  // The voxel engine holds n x n x n_theta samples; the adaptive engine only the boxes it keeps.
+  const int max_resolution = o.engine == Engine::Voxel ? kMaxVoxelResolution : kMaxAdaptiveResolution;
+  const std::string range = "[16, " + std::to_string(max_resolution) + "] for engine " + toString(o.engine);
+  if (o.resolution < 16 || o.resolution > max_resolution)
+  {
+    errors.push_back("resolution " + std::to_string(o.resolution) + " is outside " + range);
+  }
+  if (o.theta_resolution != 0 && (o.theta_resolution < 16 || o.theta_resolution > max_resolution))
+  {
+    errors.push_back("theta_resolution " + std::to_string(o.theta_resolution) + " is outside " + range +
+                     " (0 = resolution)");
+  }
+  if (o.min_inliers != 0 && (o.min_inliers < 3 || o.min_inliers > 255))
+  {
+    errors.push_back("min_inliers " + std::to_string(o.min_inliers) + " is outside [3, 255] (0 = automatic)");
+  }
+  if (o.method == Method::Paper && o.min_inliers == 0)
+  {
+    errors.push_back("method paper needs a fixed min_inliers (k' >= 3), not automatic");
+  }
+  if (!(o.agreement_tolerance > 0.0) || !std::isfinite(o.agreement_tolerance))
+  {
+    errors.push_back("agreement_tolerance " + number(o.agreement_tolerance) + " must be finite and > 0 [m]");
+  }
+  if (!(o.uniqueness_distance >= 0.0) || !std::isfinite(o.uniqueness_distance))
+  {
+    errors.push_back("uniqueness_distance " + number(o.uniqueness_distance) + " must be finite and >= 0 [m]");
+  }
+  if (!(o.uniqueness_angle >= 0.0) || !std::isfinite(o.uniqueness_angle))
+  {
+    errors.push_back("uniqueness_angle " + number(o.uniqueness_angle) + " must be finite and >= 0 [rad]");
+  }
+  if (!(o.range_tolerance >= 0.0) || !std::isfinite(o.range_tolerance))
+  {
+    errors.push_back("range_tolerance " + number(o.range_tolerance) + " must be finite and >= 0 [m]");
+  }
+  if (o.max_candidates < 1)
+  {
+    errors.push_back("max_candidates " + std::to_string(o.max_candidates) + " must be >= 1");
+  }
+  if (o.threads < 0)
+  {
+    errors.push_back("threads " + std::to_string(o.threads) + " must be >= 0 (0 = all cores)");
+  }
+  if (o.max_boxes < 1000)
+  {
+    errors.push_back("max_boxes " + std::to_string(o.max_boxes) + " must be >= 1000");
+  }
+  if (!(o.deadline >= 0.0) || !std::isfinite(o.deadline))
+  {
+    errors.push_back("deadline " + number(o.deadline) + " must be finite and >= 0 [s] (0 = none)");
+  }
+  return errors;
+}
+
+void validateReadings(const std::vector<Reading>& readings, const LocalizerOptions& options)
+{
+  const int k = static_cast<int>(readings.size());
+  if (k < 3)
+  {
+    throw InvalidInput("need at least 3 readings, got " + std::to_string(k));
+  }
+  if (k > 255)
+  {
+    throw InvalidInput("at most 255 readings per batch, got " + std::to_string(k));
+  }
+  for (int i = 0; i < k; ++i)
+  {
+    const Reading& r = readings[i];
+    const std::string which = "reading " + std::to_string(i) + ": ";
+    if (!finitePose(r.offset))
+    {
+      throw InvalidInput(which + "offset (gx, gy, gtheta) must be finite");
+    }
+    if (std::isnan(r.range))
+    {
+      throw InvalidInput(which + "range is NaN");
+    }
+    if (r.range < 0.0)
+    {
+      throw InvalidInput(which + "negative range " + number(r.range) + " m");
+    }
+    if (std::isnan(r.max_range) || !(r.max_range > 0.0))
+    {
+      throw InvalidInput(which + "max_range " + number(r.max_range) + " must be > 0 (or +inf)");
+    }
+    if (std::isinf(r.range) && !std::isfinite(r.max_range))
+    {
+      throw InvalidInput(which + "no return (range = inf) needs a finite max_range");
+    }
+    if (std::isfinite(r.range) && r.range > r.max_range)
+    {
+      throw InvalidInput(which + "range " + number(r.range) + " m exceeds max_range " + number(r.max_range) + " m");
+    }
+  }
+  if (options.min_inliers > k)
+  {
+    throw InvalidInput("min_inliers k' = " + std::to_string(options.min_inliers) +
+                       " exceeds the number of readings k = " + std::to_string(k));
+  }
+}
+
+Localizer::Localizer(std::shared_ptr<const MapRayCaster> map, const LocalizerOptions& options)
+  : map_(std::move(map)), options_(options)
+{
+  const std::vector<std::string> errors = validate(options_);
+  if (!errors.empty())
+  {
+    std::string text = "invalid localizer options:";
+    for (const std::string& e : errors)
+    {
+      text += "\n  " + e;
+    }
+    throw std::invalid_argument(text);
+  }
+  if (!map_ || map_->map().empty() || !(map_->map().area() > 0.0))
+  {
+    throw std::invalid_argument("the map has no area");
+  }
+  switch (options_.engine)
+  {
+    case Engine::Voxel:
+      engine_ = std::make_unique<VoxelEngine>(map_, options_);
+      break;
+    case Engine::Adaptive:
+      engine_ = std::make_unique<AdaptiveEngine>(map_, options_);
+      break;
+  }
+}
+
+Localizer::~Localizer() = default;
+
+void Localizer::prepare()
+{
+  engine_->prepare();
+}
+
+Result Localizer::localize(const std::vector<Reading>& readings)
+{
+  validateReadings(readings, options_);
+  return engine_->localize(readings);
+}
+
+}  // namespace core
+}  // namespace fdml_localization

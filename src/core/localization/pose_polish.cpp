@@ -1,0 +1,201 @@
+#include "fdml_localization/core/localization/robust_search.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <cmath>
+
+namespace fdml_localization
+{
+namespace core
+{
+namespace
+{
+/// Residual [m] charged to a ray that leaves free space or misses, during the polish.
+constexpr double kPenaltyResidual = 1.0;
+
+/// One reading's residual and its derivative with respect to (x, y, theta).
+struct ResidualRow
+{
+  double r = 0.0;
+  Eigen::RowVector3d jacobian = Eigen::RowVector3d::Zero();
+  bool valid = false;
+};
+
+/// cos and sin of the robot's heading and of a reading's mounting angle.
+struct Rotation
+{
+  double c = 1.0;
+  double s = 0.0;
+  explicit Rotation(double angle) : c(std::cos(angle)), s(std::sin(angle))
+  {}
+};
+
+ResidualRow residualRow(const MapRayCaster& map, const Pose2& q, const Rotation& rq, const Reading& reading,
+                        const Rotation& rg)
+{
+  ResidualRow row;
+  const double c = rq.c;
+  const double s = rq.s;
+  const Vec2 origin(q.x + c * reading.offset.x - s * reading.offset.y,
+                    q.y + s * reading.offset.x + c * reading.offset.y);
+  if (!map.isFree(origin))
+  {
+    return row;
+  }
+  const Vec2 u(c * rg.c - s * rg.s, s * rg.c + c * rg.s);
+  const RayHit hit = map.cast(origin, u);
+  if (!hit.hit() || !std::isfinite(hit.distance))
+  {
+    return row;
+  }
+  row.valid = true;
+  row.r = hit.distance - reading.range;
+  const Segment& seg = map.grid().segments()[static_cast<std::size_t>(hit.segment)];
+  const Vec2 edge = seg.b - seg.a;
+  const double len = edge.norm();
+  if (len <= 0.0)
+  {
+    return row;
+  }
+  const Vec2 n(-edge.y() / len, edge.x() / len);
+  const double nu = n.dot(u);
+  if (std::abs(nu) < 1e-6)
+  {
+    return row;
+  }
+  // t = (c - n.p) / (n.u): dt/dp = -n / (n.u), dt/dphi = -t (n.u_perp) / (n.u).
+  const Vec2 dp_dtheta(-s * reading.offset.x - c * reading.offset.y, c * reading.offset.x - s * reading.offset.y);
+  const Vec2 u_perp(-u.y(), u.x());
+  row.jacobian(0) = -n.x() / nu;
+  row.jacobian(1) = -n.y() / nu;
+  row.jacobian(2) = -n.dot(dp_dtheta) / nu - hit.distance * n.dot(u_perp) / nu;
+  return row;
+}
+
+struct System
+{
+  double cost = 0.0;
+  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d g = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
+  double sum_sq = 0.0;
+  int used = 0;
+};
+
+System buildSystem(const MapRayCaster& map, const Pose2& q, const std::vector<Reading>& readings,
+                   const std::vector<Rotation>& mounts, const std::vector<bool>& use, double scale)
+{
+  System sys;
+  const Rotation rq(q.theta);
+  for (std::size_t i = 0; i < readings.size(); ++i)
+  {
+    if (!use[i] || !std::isfinite(readings[i].range))
+    {
+      continue;
+    }
+    const ResidualRow row = residualRow(map, q, rq, readings[i], mounts[i]);
+    ++sys.used;
+    if (!row.valid)
+    {
+      const double p = kPenaltyResidual;
+      sys.cost += scale > 0.0 ? scale * scale * std::log1p((p / scale) * (p / scale)) : p * p;
+      continue;
+    }
+    double w = 1.0;
+    if (scale > 0.0)
+    {
+      const double z = (row.r / scale) * (row.r / scale);
+      sys.cost += scale * scale * std::log1p(z);
+      w = 1.0 / (1.0 + z);
+    }
+    else
+    {
+      sys.cost += row.r * row.r;
+    }
+    sys.h += w * row.jacobian.transpose() * row.jacobian;
+    sys.g += w * row.jacobian.transpose() * row.r;
+    sys.jtj += row.jacobian.transpose() * row.jacobian;
+    sys.sum_sq += row.r * row.r;
+  }
+  return sys;
+}
+
+Pose2 step(const Pose2& q, const Eigen::Vector3d& delta)
+{
+  return Pose2(q.x + delta(0), q.y + delta(1), wrapAngle(q.theta + delta(2)));
+}
+}  // namespace
+
+PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std::vector<Reading>& readings,
+                         const std::vector<bool>& use, double robust_scale, int max_iterations, double noise_sigma)
+{
+  PolishOutcome out;
+  out.pose = start;
+  std::vector<Rotation> mounts;
+  mounts.reserve(readings.size());
+  for (const Reading& r : readings)
+  {
+    mounts.emplace_back(r.offset.theta);
+  }
+  System sys = buildSystem(map, out.pose, readings, mounts, use, robust_scale);
+  double lambda = 1e-3;
+  for (int iter = 0; iter < max_iterations; ++iter)
+  {
+    out.iterations = iter + 1;
+    Eigen::Matrix3d a = sys.h;
+    a.diagonal() += lambda * sys.h.diagonal() + Eigen::Vector3d::Constant(1e-12);
+    Eigen::Vector3d delta = -a.ldlt().solve(sys.g);
+    if (!delta.allFinite())
+    {
+      break;
+    }
+    // Keep each step local: the ray-cast model only holds near the current pose.
+    const double max_shift = 0.5;
+    const double max_turn = 0.3;
+    const double shift = delta.head<2>().norm();
+    const double scale = std::max({ 1.0, shift / max_shift, std::abs(delta(2)) / max_turn });
+    delta /= scale;
+    const Pose2 trial = step(out.pose, delta);
+    const System next = buildSystem(map, trial, readings, mounts, use, robust_scale);
+    if (next.cost < sys.cost)
+    {
+      out.pose = trial;
+      sys = next;
+      lambda = std::max(lambda / 3.0, 1e-9);
+      if (delta.head<2>().norm() < 1e-8 && std::abs(delta(2)) < 1e-9)
+      {
+        break;
+      }
+    }
+    else
+    {
+      lambda *= 4.0;
+      if (lambda > 1e8)
+      {
+        break;
+      }
+    }
+  }
+  const System final_sys = buildSystem(map, out.pose, readings, mounts, use, 0.0);
+  const int dof = final_sys.used - 3;
+  double sigma2 = noise_sigma * noise_sigma;
+  if (dof > 0)
+  {
+    sigma2 = std::max(sigma2, final_sys.sum_sq / dof);
+  }
+  Eigen::FullPivLU<Eigen::Matrix3d> lu(final_sys.jtj);
+  if (lu.rank() == 3)
+  {
+    out.covariance = sigma2 * lu.inverse();
+  }
+  else
+  {
+    out.covariance = Eigen::Matrix3d::Identity() * 1e6;
+  }
+  return out;
+}
+
+}  // namespace core
+}  // namespace fdml_localization

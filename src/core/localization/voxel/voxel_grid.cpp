@@ -1,0 +1,237 @@
+#include "fdml_localization/core/localization/voxel/voxel_grid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+namespace fdml_localization
+{
+namespace core
+{
+namespace
+{
+std::uint64_t mixHash(std::uint64_t h, std::uint64_t value)
+{
+  h ^= value + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
+  h *= 0xff51afd7ed558ccdULL;
+  return h ^ (h >> 33);
+}
+
+std::uint64_t doubleBits(double value)
+{
+  std::uint64_t bits = 0;
+  static_assert(sizeof(bits) == sizeof(value), "double is 64 bits");
+  std::memcpy(&bits, &value, sizeof(bits));
+  return bits;
+}
+}  // namespace
+
+GridSpec GridSpec::fromMap(const PolygonMap& map, int resolution, int theta_resolution)
+{
+  if (resolution < 16 || resolution > 1024)
+  {
+    throw std::invalid_argument("resolution " + std::to_string(resolution) + " is outside [16, 1024]");
+  }
+  if (theta_resolution != 0 && (theta_resolution < 16 || theta_resolution > 1024))
+  {
+    throw std::invalid_argument("theta_resolution " + std::to_string(theta_resolution) +
+                                " is outside [16, 1024] (or 0 = resolution)");
+  }
+  if (map.empty() || !(map.area() > 0.0))
+  {
+    throw std::invalid_argument("the map has no area");
+  }
+  const Box2& b = map.bounds();
+  const double width = b.max.x() - b.min.x();
+  const double height = b.max.y() - b.min.y();
+  GridSpec spec;
+  spec.cell = std::max(width, height) / resolution;
+  spec.nx = static_cast<int>(std::ceil(width / spec.cell - 1e-9)) + 2;
+  spec.ny = static_cast<int>(std::ceil(height / spec.cell - 1e-9)) + 2;
+  spec.nt = theta_resolution > 0 ? theta_resolution : resolution;
+  spec.origin_x = b.min.x() - 0.5 * (spec.nx * spec.cell - width);
+  spec.origin_y = b.min.y() - 0.5 * (spec.ny * spec.cell - height);
+  return spec;
+}
+
+double GridSpec::thetaStep() const
+{
+  return kTwoPi / nt;
+}
+
+void GridSpec::unindex(std::size_t v, int& ix, int& iy, int& it) const
+{
+  ix = static_cast<int>(v % nx);
+  const std::size_t rest = v / nx;
+  iy = static_cast<int>(rest % ny);
+  it = static_cast<int>(rest / ny);
+}
+
+double GridSpec::centreTheta(int it) const
+{
+  return -kPi + (it + 0.5) * thetaStep();
+}
+
+Pose2 GridSpec::centre(std::size_t v) const
+{
+  int ix = 0;
+  int iy = 0;
+  int it = 0;
+  unindex(v, ix, iy, it);
+  return Pose2(centreX(ix), centreY(iy), centreTheta(it));
+}
+
+bool GridSpec::locate(const Pose2& pose, int& ix, int& iy, int& it) const
+{
+  const double fx = std::floor((pose.x - origin_x) / cell);
+  const double fy = std::floor((pose.y - origin_y) / cell);
+  if (!(fx >= 0.0 && fx < nx && fy >= 0.0 && fy < ny))
+  {
+    return false;
+  }
+  ix = static_cast<int>(fx);
+  iy = static_cast<int>(fy);
+  const double ft = std::floor((wrapAngle(pose.theta) + kPi) / thetaStep());
+  it = static_cast<int>(ft) % nt;
+  if (it < 0)
+  {
+    it += nt;
+  }
+  return true;
+}
+
+std::uint64_t GridSpec::hash() const
+{
+  std::uint64_t h = 0x5f1d3a7c2b9e8d41ULL;
+  h = mixHash(h, doubleBits(origin_x));
+  h = mixHash(h, doubleBits(origin_y));
+  h = mixHash(h, doubleBits(cell));
+  h = mixHash(h, static_cast<std::uint64_t>(nx));
+  h = mixHash(h, static_cast<std::uint64_t>(ny));
+  h = mixHash(h, static_cast<std::uint64_t>(nt));
+  return h;
+}
+
+bool GridSpec::operator==(const GridSpec& other) const
+{
+  return origin_x == other.origin_x && origin_y == other.origin_y && cell == other.cell && nx == other.nx &&
+         ny == other.ny && nt == other.nt;
+}
+
+VoxelSet::VoxelSet(const GridSpec& spec) : nx_(spec.nx), ny_(spec.ny), nt_(spec.nt), words_per_row_((spec.nx + 63) / 64)
+{
+  words_.assign(static_cast<std::size_t>(words_per_row_) * ny_ * nt_, 0);
+}
+
+std::size_t VoxelSet::count() const
+{
+  std::size_t total = 0;
+  for (std::uint64_t w : words_)
+  {
+    total += static_cast<std::size_t>(__builtin_popcountll(w));
+  }
+  return total;
+}
+
+void VoxelSet::clear()
+{
+  std::fill(words_.begin(), words_.end(), 0);
+}
+
+VoxelSet VoxelSet::dilated() const
+{
+  const int wpr = words_per_row_;
+  const std::size_t rows = static_cast<std::size_t>(ny_) * nt_;
+  const int tail_bits = nx_ - (wpr - 1) * 64;
+  const std::uint64_t tail_mask = tail_bits >= 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << tail_bits) - 1;
+
+  // Along x, inside each row.
+  VoxelSet along_x(*this);
+  for (std::size_t r = 0; r < rows; ++r)
+  {
+    const std::uint64_t* in = words_.data() + r * wpr;
+    std::uint64_t* out = along_x.words_.data() + r * wpr;
+    for (int k = 0; k < wpr; ++k)
+    {
+      const std::uint64_t w = in[k];
+      std::uint64_t d = w | (w << 1) | (w >> 1);
+      if (k > 0)
+      {
+        d |= in[k - 1] >> 63;
+      }
+      if (k + 1 < wpr)
+      {
+        d |= in[k + 1] << 63;
+      }
+      out[k] = d;
+    }
+    out[wpr - 1] &= tail_mask;
+  }
+  // Along y, inside each theta slice.
+  VoxelSet along_y(*this);
+  for (int it = 0; it < nt_; ++it)
+  {
+    for (int iy = 0; iy < ny_; ++iy)
+    {
+      std::uint64_t* out = along_y.row(iy, it);
+      const std::uint64_t* mid = along_x.row(iy, it);
+      const std::uint64_t* lo = iy > 0 ? along_x.row(iy - 1, it) : nullptr;
+      const std::uint64_t* hi = iy + 1 < ny_ ? along_x.row(iy + 1, it) : nullptr;
+      for (int k = 0; k < wpr; ++k)
+      {
+        out[k] = mid[k] | (lo ? lo[k] : 0) | (hi ? hi[k] : 0);
+      }
+    }
+  }
+  // Along theta, periodic.
+  VoxelSet result(*this);
+  const std::size_t slice = static_cast<std::size_t>(ny_) * wpr;
+  for (int it = 0; it < nt_; ++it)
+  {
+    const std::uint64_t* prev = along_y.words_.data() + ((it + nt_ - 1) % nt_) * slice;
+    const std::uint64_t* mid = along_y.words_.data() + it * slice;
+    const std::uint64_t* next = along_y.words_.data() + ((it + 1) % nt_) * slice;
+    std::uint64_t* out = result.words_.data() + it * slice;
+    for (std::size_t k = 0; k < slice; ++k)
+    {
+      out[k] = prev[k] | mid[k] | next[k];
+    }
+  }
+  return result;
+}
+
+VoxelSet& VoxelSet::operator&=(const VoxelSet& other)
+{
+  if (other.words_.size() != words_.size())
+  {
+    throw std::invalid_argument("VoxelSet: grids differ");
+  }
+  for (std::size_t k = 0; k < words_.size(); ++k)
+  {
+    words_[k] &= other.words_[k];
+  }
+  return *this;
+}
+
+VoxelSet& VoxelSet::operator|=(const VoxelSet& other)
+{
+  if (other.words_.size() != words_.size())
+  {
+    throw std::invalid_argument("VoxelSet: grids differ");
+  }
+  for (std::size_t k = 0; k < words_.size(); ++k)
+  {
+    words_[k] |= other.words_[k];
+  }
+  return *this;
+}
+
+bool VoxelSet::operator==(const VoxelSet& other) const
+{
+  return nx_ == other.nx_ && ny_ == other.ny_ && nt_ == other.nt_ && words_ == other.words_;
+}
+
+}  // namespace core
+}  // namespace fdml_localization

@@ -1,0 +1,201 @@
+#include "fdml_localization/core/map/grid/grid_raster.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+namespace fdml_localization
+{
+namespace core
+{
+namespace
+{
+/// Uniform in [0, 1) from a 64-bit engine (exactly reproducible across standard libraries).
+double uniform(std::mt19937_64& rng)
+{
+  return static_cast<double>(rng() >> 11) * (1.0 / 9007199254740992.0);
+}
+
+int uniformInt(std::mt19937_64& rng, int n)
+{
+  return std::min(n - 1, static_cast<int>(uniform(rng) * n));
+}
+
+void checkOptions(const RasterizeOptions& o)
+{
+  if (!(std::isfinite(o.resolution) && o.resolution > 0.0))
+  {
+    throw std::invalid_argument("rasterize: resolution must be > 0 [m]");
+  }
+  if (!(std::isfinite(o.margin) && o.margin >= 0.0))
+  {
+    throw std::invalid_argument("rasterize: margin must be >= 0 [m]");
+  }
+  if (!(std::isfinite(o.wall_thickness) && o.wall_thickness >= 0.0))
+  {
+    throw std::invalid_argument("rasterize: wall_thickness must be >= 0 [m]");
+  }
+  if (!(o.boundary_noise >= 0.0 && o.boundary_noise <= 1.0))
+  {
+    throw std::invalid_argument("rasterize: boundary_noise must be in [0, 1]");
+  }
+  if (o.specks < 0 || o.islands < 0)
+  {
+    throw std::invalid_argument("rasterize: specks and islands must be >= 0");
+  }
+}
+
+/// True when every cell of the box [x0, x1] x [y0, y1] exists and has value @p value.
+bool boxIs(const OccupancyGrid& grid, int x0, int y0, int x1, int y1, std::int8_t value)
+{
+  for (int y = y0; y <= y1; ++y)
+  {
+    for (int x = x0; x <= x1; ++x)
+    {
+      if (!grid.inside(x, y) || grid.at(x, y) != value)
+      {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+/// Puts up to @p count blobs of 1..2 x 1..2 cells of @p paint where a 2-cell ring around
+/// the blob holds only @p background.
+void addBlobs(OccupancyGrid* grid, int count, std::int8_t background, std::int8_t paint, std::mt19937_64& rng)
+{
+  int placed = 0;
+  for (int attempt = 0; attempt < 200 * count && placed < count; ++attempt)
+  {
+    const int x = uniformInt(rng, grid->width);
+    const int y = uniformInt(rng, grid->height);
+    const int sx = 1 + uniformInt(rng, 2);
+    const int sy = 1 + uniformInt(rng, 2);
+    if (!boxIs(*grid, x - 2, y - 2, x + sx + 1, y + sy + 1, background))
+    {
+      continue;
+    }
+    for (int yy = y; yy < y + sy; ++yy)
+    {
+      for (int xx = x; xx < x + sx; ++xx)
+      {
+        grid->at(xx, yy) = paint;
+      }
+    }
+    ++placed;
+  }
+}
+}  // namespace
+
+OccupancyGrid rasterize(const PolygonMap& map, const RasterizeOptions& options)
+{
+  checkOptions(options);
+  if (map.empty())
+  {
+    throw std::invalid_argument("rasterize: empty map");
+  }
+  const double res = options.resolution;
+  OccupancyGrid grid;
+  grid.resolution = res;
+  const Box2& bounds = map.bounds();
+  grid.origin = Pose2(bounds.min.x() - options.margin, bounds.min.y() - options.margin, 0.0);
+  grid.width = static_cast<int>(std::ceil((bounds.size().x() + 2.0 * options.margin) / res));
+  grid.height = static_cast<int>(std::ceil((bounds.size().y() + 2.0 * options.margin) / res));
+  grid.cells.assign(static_cast<std::size_t>(grid.width) * grid.height, -1);
+
+  // Free cells: centre inside the free space (even-odd scanline over every ring's edges).
+  std::vector<double> xs;
+  for (int iy = 0; iy < grid.height; ++iy)
+  {
+    const double y = grid.origin.y + (iy + 0.5) * res;
+    xs.clear();
+    for (const Ring& ring : map.rings())
+    {
+      for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++)
+      {
+        const Vec2& a = ring[j];
+        const Vec2& b = ring[i];
+        if ((a.y() > y) != (b.y() > y))
+        {
+          xs.push_back(a.x() + (y - a.y()) * (b.x() - a.x()) / (b.y() - a.y()));
+        }
+      }
+    }
+    std::sort(xs.begin(), xs.end());
+    for (std::size_t k = 0; k + 1 < xs.size(); k += 2)
+    {
+      const int x0 = std::max(0, static_cast<int>(std::ceil((xs[k] - grid.origin.x) / res - 0.5)));
+      const int x1 = std::min(grid.width - 1, static_cast<int>(std::ceil((xs[k + 1] - grid.origin.x) / res - 0.5)) - 1);
+      for (int ix = x0; ix <= x1; ++ix)
+      {
+        grid.at(ix, iy) = 0;
+      }
+    }
+  }
+  // Walls: non-free cells within wall_thickness (Chebyshev, in cells) of a free cell.
+  const int k = static_cast<int>(std::ceil(options.wall_thickness / res));
+  std::vector<char> near(grid.cells.size(), 0);
+  std::vector<char> row_near(grid.cells.size(), 0);
+  for (int iy = 0; iy < grid.height; ++iy)
+  {
+    int last_free = -1000000;
+    for (int ix = 0; ix < grid.width; ++ix)
+    {
+      last_free = grid.at(ix, iy) == 0 ? ix : last_free;
+      row_near[grid.index(ix, iy)] = ix - last_free <= k;
+    }
+    last_free = 1000000;
+    for (int ix = grid.width - 1; ix >= 0; --ix)
+    {
+      last_free = grid.at(ix, iy) == 0 ? ix : last_free;
+      row_near[grid.index(ix, iy)] |= last_free - ix <= k;
+    }
+  }
+  for (int ix = 0; ix < grid.width; ++ix)
+  {
+    for (int iy = 0; iy < grid.height; ++iy)
+    {
+      for (int d = -k; d <= k && !near[grid.index(ix, iy)]; ++d)
+      {
+        near[grid.index(ix, iy)] = grid.inside(ix, iy + d) && row_near[grid.index(ix, iy + d)];
+      }
+    }
+  }
+  for (std::size_t i = 0; i < grid.cells.size(); ++i)
+  {
+    if (grid.cells[i] != 0 && near[i])
+    {
+      grid.cells[i] = 100;
+    }
+  }
+
+  std::mt19937_64 rng(options.seed);
+  if (options.boundary_noise > 0.0)
+  {
+    std::vector<std::size_t> bumps;
+    for (int iy = 1; iy + 1 < grid.height; ++iy)
+    {
+      for (int ix = 1; ix + 1 < grid.width; ++ix)
+      {
+        const bool touches = grid.at(ix, iy) == 0 && (grid.at(ix - 1, iy) == 100 || grid.at(ix + 1, iy) == 100 ||
+                                                      grid.at(ix, iy - 1) == 100 || grid.at(ix, iy + 1) == 100);
+        if (touches && uniform(rng) < options.boundary_noise)
+        {
+          bumps.push_back(grid.index(ix, iy));
+        }
+      }
+    }
+    for (std::size_t i : bumps)
+    {
+      grid.cells[i] = 100;
+    }
+  }
+  addBlobs(&grid, options.specks, 0, 100, rng);
+  addBlobs(&grid, options.islands, -1, 0, rng);
+  return grid;
+}
+
+}  // namespace core
+}  // namespace fdml_localization

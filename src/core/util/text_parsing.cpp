@@ -1,0 +1,51 @@
+#include "fdml_localization/core/util/text_parsing.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <stdexcept>
+
+namespace fdml_localization
+{
+namespace core
+{
+std::string trim(const std::string& text)
+{
+  const char* blanks = " \t\r\n\f\v";
+  const std::size_t begin = text.find_first_not_of(blanks);
+  if (begin == std::string::npos)
+  {
+    return "";
+  }
+  return text.substr(begin, text.find_last_not_of(blanks) - begin + 1);
+}
+
+double parseNumber(const std::string& text, const std::string& what, bool allow_infinite)
+{
+  const std::string t = trim(text);
+  char* end = nullptr;
+  errno = 0;
+  const double value = std::strtod(t.c_str(), &end);
+  const bool whole = !t.empty() && end == t.c_str() + t.size();
+  if (!whole || std::isnan(value) || (std::isinf(value) && !allow_infinite))
+  {
+    throw std::invalid_argument(what + ": '" + text + "' is not a " + (allow_infinite ? "number" : "finite number"));
+  }
+  return value;
+}
+
+int parseInteger(const std::string& text, const std::string& what)
+{
+  const std::string t = trim(text);
+  char* end = nullptr;
+  errno = 0;
+  const long value = std::strtol(t.c_str(), &end, 10);
+  if (t.empty() || end != t.c_str() + t.size() || errno == ERANGE || value < -1000000000L || value > 1000000000L)
+  {
+    throw std::invalid_argument(what + ": '" + text + "' is not an integer");
+  }
+  return static_cast<int>(value);
+}
+
+}  // namespace core
+}  // namespace fdml_localization

@@ -1,0 +1,347 @@
+/**
+ * @file map_generators.cpp
+ * @brief Random star-shaped polygons and procedural buildings (see map_generators.h).
+ *
+ * The building's free space is a union of axis-aligned rectangles (corridors, rooms shrunk
+ * by half the wall thickness, door openings bridging the walls) minus pillars, computed with
+ * Boost.Geometry. Free rectangles either overlap with positive area or lie at least a wall
+ * thickness apart, and door openings keep a wall thickness away from every wall corner, so
+ * the free space never pinches: holes never touch each other or the outer ring.
+ */
+#include "fdml_localization/simulation/map_generators.h"
+
+// Boost 1.74's overlay code trips GCC 12's -Wmaybe-uninitialized (a false positive).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#include <boost/geometry.hpp>
+#include <boost/geometry/geometries/multi_polygon.hpp>
+#include <boost/geometry/geometries/point_xy.hpp>
+#include <boost/geometry/geometries/polygon.hpp>
+#pragma GCC diagnostic pop
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace fdml_localization
+{
+namespace core
+{
+namespace
+{
+namespace bg = boost::geometry;
+using BgPoint = bg::model::d2::point_xy<double>;
+using BgPolygon = bg::model::polygon<BgPoint>;
+using BgMulti = bg::model::multi_polygon<BgPolygon>;
+
+/// Throws std::invalid_argument naming the parameter and its allowed range.
+void require(bool ok, const std::string& name, double value, const std::string& range)
+{
+  if (!ok)
+  {
+    std::ostringstream msg;
+    msg << name << " = " << value << " is out of range (allowed: " << range << ")";
+    throw std::invalid_argument(msg.str());
+  }
+}
+
+/// Layout unit [m]: the building is laid out in whole units so that coordinates meant to be
+/// equal are computed from the same integers and are bit-identical.
+constexpr double kUnit = 1e-4;
+using Units = std::int64_t;
+
+/// An axis-aligned rectangle in layout units.
+struct Rect
+{
+  Units x0, y0, x1, y1;
+};
+
+Units toUnits(double metres)
+{
+  return static_cast<Units>(std::llround(metres / kUnit));
+}
+
+BgPolygon toPolygon(const Rect& r)
+{
+  BgPolygon poly;
+  const double x0 = r.x0 * kUnit, y0 = r.y0 * kUnit, x1 = r.x1 * kUnit, y1 = r.y1 * kUnit;
+  // Boost's default polygon is clockwise and closed.
+  poly.outer() = { BgPoint(x0, y0), BgPoint(x0, y1), BgPoint(x1, y1), BgPoint(x1, y0), BgPoint(x0, y0) };
+  return poly;
+}
+
+/// Union of many rectangles, merged pairwise so the work stays near n log n.
+BgMulti unionOf(const std::vector<Rect>& rects)
+{
+  std::vector<BgMulti> layer;
+  layer.reserve(rects.size());
+  for (const Rect& r : rects)
+  {
+    layer.push_back(BgMulti{ toPolygon(r) });
+  }
+  while (layer.size() > 1)
+  {
+    std::vector<BgMulti> next;
+    for (std::size_t i = 0; i + 1 < layer.size(); i += 2)
+    {
+      BgMulti merged;
+      bg::union_(layer[i], layer[i + 1], merged);
+      next.push_back(std::move(merged));
+    }
+    if (layer.size() % 2 == 1)
+    {
+      next.push_back(std::move(layer.back()));
+    }
+    layer = std::move(next);
+  }
+  return layer.empty() ? BgMulti{} : layer.front();
+}
+
+/// Converts a Boost ring to ours, dropping the closing vertex and collinear vertices.
+template <typename BgRing>
+Ring toRing(const BgRing& in)
+{
+  Ring pts;
+  for (const BgPoint& p : in)
+  {
+    pts.emplace_back(p.x(), p.y());
+  }
+  pts = cleanRing(pts);
+  Ring out;
+  const std::size_t n = pts.size();
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    const Vec2& a = pts[(i + n - 1) % n];
+    const Vec2& b = pts[i];
+    const Vec2& c = pts[(i + 1) % n];
+    const Vec2 u = b - a, v = c - b;
+    const double cross = u.x() * v.y() - u.y() * v.x();
+    if (std::abs(cross) > 1e-12 * (u.norm() * v.norm()) || u.dot(v) < 0.0)
+    {
+      out.push_back(b);
+    }
+  }
+  return out;
+}
+
+/// Splits @p length into pieces near @p target, each at least @p min_piece, with random jitter.
+std::vector<Units> splitLength(Units length, Units target, Units min_piece, std::mt19937_64& rng)
+{
+  Units count = std::max<Units>(1, (length + target / 2) / target);
+  while (count > 1 && length / count < min_piece)
+  {
+    --count;
+  }
+  std::uniform_real_distribution<double> jitter(0.8, 1.2);
+  std::vector<double> weights(count);
+  double sum = 0.0;
+  for (double& w : weights)
+  {
+    w = jitter(rng);
+    sum += w;
+  }
+  std::vector<Units> pieces(count);
+  Units used = 0;
+  for (Units i = 0; i + 1 < count; ++i)
+  {
+    pieces[i] = static_cast<Units>(std::llround(length * weights[i] / sum));
+    used += pieces[i];
+  }
+  pieces.back() = length - used;
+  // Jitter must not push a piece below the minimum: fall back to equal pieces.
+  if (*std::min_element(pieces.begin(), pieces.end()) < min_piece)
+  {
+    std::fill(pieces.begin(), pieces.end(), length / count);
+    pieces.back() = length - (count - 1) * (length / count);
+  }
+  return pieces;
+}
+
+}  // namespace
+
+PolygonMap randomPolygon(int vertices, double mean_radius, double radius_noise, std::uint64_t seed)
+{
+  require(vertices >= 3, "vertices", vertices, "an integer >= 3");
+  require(std::isfinite(mean_radius) && mean_radius > 0.0, "mean_radius", mean_radius, "(0, inf) m");
+  require(std::isfinite(radius_noise) && radius_noise >= 0.0 && radius_noise < 1.0, "radius_noise", radius_noise,
+          "[0, 1)");
+
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const double min_gap = 1e-3 * kTwoPi / vertices;
+  std::vector<double> angles(vertices);
+  bool ok = false;
+  // Sorted uniform angles; reject draws with a gap of pi or more (the polygon would not be
+  // star-shaped about the origin) or with nearly coincident angles.
+  for (int attempt = 0; attempt < 1000 && !ok; ++attempt)
+  {
+    for (double& a : angles)
+    {
+      a = kTwoPi * unit(rng);
+    }
+    std::sort(angles.begin(), angles.end());
+    ok = true;
+    for (int i = 0; i < vertices && ok; ++i)
+    {
+      const double next = (i + 1 < vertices) ? angles[i + 1] : angles[0] + kTwoPi;
+      const double gap = next - angles[i];
+      ok = gap > min_gap && gap < 0.9 * kPi;
+    }
+  }
+  if (!ok)
+  {
+    // Stratified fallback (only reachable for tiny vertex counts): one angle per sector.
+    for (int i = 0; i < vertices; ++i)
+    {
+      angles[i] = kTwoPi * (i + 0.1 + 0.8 * unit(rng)) / vertices;
+    }
+  }
+  Ring ring;
+  ring.reserve(vertices);
+  for (double a : angles)
+  {
+    const double r = mean_radius * (1.0 + radius_noise * (2.0 * unit(rng) - 1.0));
+    ring.emplace_back(r * std::cos(a), r * std::sin(a));
+  }
+  std::ostringstream source;
+  source << "randomPolygon(" << vertices << ", " << mean_radius << ", " << radius_noise << ", seed " << seed << ")";
+  return PolygonMap::fromRings({ ring }, source.str());
+}
+
+PolygonMap generateBuilding(const BuildingOptions& o)
+{
+  require(std::isfinite(o.wall_thickness) && o.wall_thickness >= 4.0 * kUnit && o.wall_thickness <= 1.0,
+          "wall_thickness", o.wall_thickness, "[0.0004, 1] m");
+  require(std::isfinite(o.door_width) && o.door_width >= 0.1 && o.door_width <= 100.0, "door_width", o.door_width,
+          "[0.1, 100] m");
+  require(std::isfinite(o.corridor_width) && o.corridor_width >= 2.0 * o.wall_thickness && o.corridor_width <= 100.0,
+          "corridor_width", o.corridor_width, "[2 * wall_thickness, 100] m");
+  // A room must hold a door a wall thickness away from each corner.
+  const double min_room = std::max(o.door_width + 4.0 * o.wall_thickness, 1.0);
+  require(std::isfinite(o.room_size) && o.room_size >= min_room && o.room_size <= 1000.0, "room_size", o.room_size,
+          "[max(door_width + 4 * wall_thickness, 1), 1000] m");
+  const double min_side = 2.0 * min_room + o.corridor_width;
+  require(std::isfinite(o.width) && o.width >= min_side && o.width <= 10000.0, "width", o.width,
+          "[2 * max(door_width + 4 * wall_thickness, 1) + corridor_width, 10000] m");
+  require(std::isfinite(o.height) && o.height >= min_side && o.height <= 10000.0, "height", o.height,
+          "[2 * max(door_width + 4 * wall_thickness, 1) + corridor_width, 10000] m");
+  require(o.pillar_probability >= 0.0 && o.pillar_probability <= 1.0, "pillar_probability", o.pillar_probability,
+          "[0, 1]");
+
+  std::mt19937_64 rng(o.seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  auto random_between = [&](Units lo, Units hi) { return lo + static_cast<Units>(std::floor((hi - lo) * unit(rng))); };
+  // Wall thickness a multiple of 4 units, so that half and three quarters of it are whole units.
+  const Units t = 4 * std::max<Units>(1, toUnits(o.wall_thickness / 4.0));
+  const Units h = t / 2, door_reach = 3 * t / 4;
+  const Units c = toUnits(o.corridor_width), d = toUnits(o.door_width), room = toUnits(o.room_size);
+  const Units width = toUnits(o.width), height = toUnits(o.height);
+  const Units min_room_u = std::max<Units>(d + 4 * t, toUnits(1.0));
+
+  // Along y: bands of [room row, corridor, room row]; every room row touches one corridor.
+  Units bands = std::max<Units>(1, static_cast<Units>(std::llround(o.height / (2.0 * o.room_size + o.corridor_width))));
+  while (bands > 1 && (height - bands * c) / (2 * bands) < min_room_u)
+  {
+    --bands;
+  }
+  const Units row_h = (height - bands * c) / (2 * bands);
+  require(row_h >= min_room_u, "height", o.height, "large enough for a row of rooms on each side of a corridor");
+  // Along x: blocks of rooms separated by vertical corridors that link the horizontal ones.
+  Units vcorr =
+      std::max<Units>(1, static_cast<Units>(std::llround(o.width / (3.0 * o.room_size + o.corridor_width))) - 1);
+  while (vcorr > 1 && (width - vcorr * c) / (vcorr + 1) < min_room_u)
+  {
+    --vcorr;
+  }
+  const std::vector<Units> block_w = splitLength(width - vcorr * c, (width - vcorr * c) / (vcorr + 1), min_room_u, rng);
+  require(static_cast<Units>(block_w.size()) == vcorr + 1 &&
+              *std::min_element(block_w.begin(), block_w.end()) >= min_room_u,
+          "width", o.width, "large enough for a room on each side of a vertical corridor");
+
+  std::vector<Rect> free_rects;
+  std::vector<Rect> pillars;
+  std::vector<Units> block_x0;
+  Units x = 0;
+  for (std::size_t b = 0; b < block_w.size(); ++b)
+  {
+    block_x0.push_back(x);
+    x += block_w[b];
+    if (b + 1 < block_w.size())
+    {
+      free_rects.push_back({ x + h, h, x + c - h, height - h });  // vertical corridor
+      x += c;
+    }
+  }
+  const Units pillar = std::max(toUnits(0.3), 2 * t);
+  const Units pillar_margin = std::max(toUnits(0.5), t);
+  for (Units band = 0; band < bands; ++band)
+  {
+    const Units y0 = band * (2 * row_h + c);
+    const Units yc0 = y0 + row_h, yc1 = yc0 + c;  // corridor of this band
+    free_rects.push_back({ h, yc0 + h, width - h, yc1 - h });
+    for (int side = 0; side < 2; ++side)
+    {
+      const Units ry0 = side == 0 ? y0 : yc1;
+      const Units ry1 = ry0 + row_h;
+      const Units wall_y = side == 0 ? yc0 : yc1;  // the wall shared with the corridor
+      for (std::size_t b = 0; b < block_w.size(); ++b)
+      {
+        const std::vector<Units> widths = splitLength(block_w[b], room, min_room_u, rng);
+        Units rx0 = block_x0[b];
+        for (std::size_t k = 0; k < widths.size(); ++k)
+        {
+          const Units rx1 = rx0 + widths[k];
+          const Rect r{ rx0 + h, ry0 + h, rx1 - h, ry1 - h };
+          free_rects.push_back(r);
+          // Door to the corridor, a wall thickness away from the room's corners.
+          const Units dx = random_between(r.x0 + t, r.x1 - t - d);
+          free_rects.push_back({ dx, wall_y - door_reach, dx + d, wall_y + door_reach });
+          // Sometimes a connecting door to the next room in the row.
+          if (k + 1 < widths.size() && unit(rng) < 0.35)
+          {
+            const Units dy = random_between(r.y0 + t, r.y1 - t - d);
+            free_rects.push_back({ rx1 - door_reach, dy, rx1 + door_reach, dy + d });
+          }
+          const Units px_room = r.x1 - r.x0 - pillar - 2 * pillar_margin;
+          const Units py_room = r.y1 - r.y0 - pillar - 2 * pillar_margin;
+          if (unit(rng) < o.pillar_probability && px_room > 0 && py_room > 0)
+          {
+            const Units px = random_between(r.x0 + pillar_margin, r.x0 + pillar_margin + px_room);
+            const Units py = random_between(r.y0 + pillar_margin, r.y0 + pillar_margin + py_room);
+            pillars.push_back({ px, py, px + pillar, py + pillar });
+          }
+          rx0 = rx1;
+        }
+      }
+    }
+  }
+
+  BgMulti free_space = unionOf(free_rects);
+  if (!pillars.empty())
+  {
+    BgMulti with_pillars;
+    bg::difference(free_space, unionOf(pillars), with_pillars);
+    free_space = std::move(with_pillars);
+  }
+  std::ostringstream source;
+  source << "generateBuilding(" << o.width << " x " << o.height << ", seed " << o.seed << ")";
+  if (free_space.size() != 1)
+  {
+    throw MapError(source.str(), 0, "free space has " + std::to_string(free_space.size()) + " components, expected 1");
+  }
+  std::vector<Ring> rings;
+  rings.push_back(toRing(free_space.front().outer()));
+  for (const auto& inner : free_space.front().inners())
+  {
+    rings.push_back(toRing(inner));
+  }
+  return PolygonMap::fromRings(std::move(rings), source.str());
+}
+
+}  // namespace core
+}  // namespace fdml_localization

@@ -1,0 +1,433 @@
+#include "fdml_localization/simulation/simulation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace fdml_localization
+{
+namespace core
+{
+namespace
+{
+constexpr int kRandomPoseTries = 20000;
+constexpr double kTimeEpsilon = 1e-9;  // [s]
+
+std::string formatPoint(const Vec2& p)
+{
+  std::ostringstream out;
+  out << "(" << p.x() << ", " << p.y() << ")";
+  return out.str();
+}
+}  // namespace
+
+Simulation::Simulation(const ScenarioConfig& config, std::shared_ptr<const MapRayCaster> map)
+  : config_(config), map_(map), scene_(map), rng_(config.seed), dt_(1.0 / config.step_rate)
+{}
+
+std::unique_ptr<Simulation> Simulation::create(const ScenarioConfig& config, std::shared_ptr<const MapRayCaster> map,
+                                               std::vector<std::string>* errors)
+{
+  const std::size_t before = errors->size();
+  if (!map || map->map().empty())
+  {
+    errors->push_back("map_file: the map is empty");
+    return nullptr;
+  }
+  std::unique_ptr<Simulation> sim(new Simulation(config, map));
+  sim->checkWaypoints(errors);
+  if (sim->placeRobot(errors))
+  {
+    sim->placeObstacles(errors);
+  }
+  if (errors->size() != before)
+  {
+    return nullptr;
+  }
+  sim->initial_pose_ = sim->true_pose_;
+  sim->initial_obstacles_ = sim->obstacles_;
+  sim->initial_waypoint_ = sim->robot_waypoint_;
+  sim->next_sensor_time_.assign(config.sensors.size(), sim->dt_);
+  sim->next_scan_time_ = sim->dt_;
+  sim->next_odom_time_ = sim->dt_;
+  sim->syncScene();
+  return sim;
+}
+
+bool Simulation::discClearOfWalls(const Vec2& centre, double radius) const
+{
+  if (!map_->isFree(centre))
+  {
+    return false;
+  }
+  Box2 box;
+  box.extend(centre - Vec2(radius, radius));
+  box.extend(centre + Vec2(radius, radius));
+  bool clear = true;
+  const auto& segments = map_->grid().segments();
+  map_->grid().forEachSegmentInBox(box, [&](int i) {
+    clear = pointSegmentDistanceSquared(centre, segments[static_cast<std::size_t>(i)]) >= radius * radius;
+    return clear;
+  });
+  return clear;
+}
+
+bool Simulation::pathClearOfWalls(const Vec2& a, const Vec2& b, double radius) const
+{
+  if (!discClearOfWalls(a, radius) || !discClearOfWalls(b, radius))
+  {
+    return false;
+  }
+  Box2 box;
+  box.extend(a.cwiseMin(b) - Vec2(radius, radius));
+  box.extend(a.cwiseMax(b) + Vec2(radius, radius));
+  const Segment path{ a, b };
+  bool clear = true;
+  const auto& segments = map_->grid().segments();
+  map_->grid().forEachSegmentInBox(box, [&](int i) {
+    const Segment& wall = segments[static_cast<std::size_t>(i)];
+    const double r2 = radius * radius;
+    clear = !segmentsIntersect(path, wall) && pointSegmentDistanceSquared(wall.a, path) >= r2 &&
+            pointSegmentDistanceSquared(wall.b, path) >= r2;
+    return clear;
+  });
+  return clear;
+}
+
+bool Simulation::checkWaypoints(std::vector<std::string>* errors) const
+{
+  const std::size_t before = errors->size();
+  auto check_loop = [&](const std::vector<Vec2>& points, double radius, const std::string& path) {
+    for (std::size_t i = 0; i < points.size(); ++i)
+    {
+      const Vec2& a = points[i];
+      const Vec2& b = points[(i + 1) % points.size()];
+      if (!discClearOfWalls(a, radius))
+      {
+        errors->push_back(path + "[" + std::to_string(i) + "]: " + formatPoint(a) +
+                          " is not in free space with a clearance of " + std::to_string(radius) + " m");
+      }
+      else if (points.size() > 1 && !pathClearOfWalls(a, b, radius))
+      {
+        errors->push_back(path + "[" + std::to_string(i) + "]: the path to the next waypoint " + formatPoint(b) +
+                          " passes closer than " + std::to_string(radius) + " m to a wall");
+      }
+    }
+  };
+  if (config_.robot.motion == RobotMotion::Waypoints)
+  {
+    check_loop(config_.robot.waypoints, config_.robot.radius + config_.clearance, "robot.waypoints");
+  }
+  for (std::size_t g = 0; g < config_.obstacles.size(); ++g)
+  {
+    const ObstacleGroupConfig& group = config_.obstacles[g];
+    if (group.motion == ObstacleMotion::Waypoints && !group.polygon)
+    {
+      check_loop(group.waypoints, group.radius + config_.clearance, "obstacles[" + std::to_string(g) + "].waypoints");
+    }
+  }
+  return errors->size() == before;
+}
+
+bool Simulation::randomFreePose(Pose2* pose)
+{
+  const Box2& b = map_->map().bounds();
+  std::uniform_real_distribution<double> ux(b.min.x(), b.max.x());
+  std::uniform_real_distribution<double> uy(b.min.y(), b.max.y());
+  std::uniform_real_distribution<double> ut(-kPi, kPi);
+  for (int i = 0; i < kRandomPoseTries; ++i)
+  {
+    const Vec2 p(ux(rng_), uy(rng_));
+    if (robotFits(p))
+    {
+      *pose = Pose2(p.x(), p.y(), ut(rng_));
+      return true;
+    }
+  }
+  return false;
+}
+
+bool Simulation::placeRobot(std::vector<std::string>* errors)
+{
+  const RobotConfig& robot = config_.robot;
+  if (!robot.random_start)
+  {
+    if (!robotFits(robot.start.position()))
+    {
+      errors->push_back("robot.start: " + formatPoint(robot.start.position()) + " is not free for a robot of radius " +
+                        std::to_string(robot.radius) + " m");
+      return false;
+    }
+    true_pose_ = robot.start;
+  }
+  else if (robot.motion == RobotMotion::Waypoints)
+  {
+    const Vec2 d = robot.waypoints[1] - robot.waypoints[0];
+    true_pose_ = Pose2(robot.waypoints[0].x(), robot.waypoints[0].y(), std::atan2(d.y(), d.x()));
+  }
+  else if (!randomFreePose(&true_pose_))
+  {
+    errors->push_back("robot.radius: no free start pose found for a robot of radius " + std::to_string(robot.radius) +
+                      " m (is the map too small?)");
+    return false;
+  }
+  robot_waypoint_ = robot.motion == RobotMotion::Waypoints && robot.random_start ? 1 : 0;
+  return true;
+}
+
+bool Simulation::robotFits(const Vec2& p) const
+{
+  const double radius = config_.robot.radius + config_.clearance;
+  if (!discClearOfWalls(p, radius))
+  {
+    return false;
+  }
+  for (std::size_t i = 0; i < obstacles_.size(); ++i)
+  {
+    if (!obstacleFits(i, obstacles_[i].position, p))
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+void Simulation::setVelocityCommand(double linear, double angular)
+{
+  const RobotConfig& r = config_.robot;
+  if (!std::isfinite(linear) || !std::isfinite(angular))
+  {
+    linear = 0.0;
+    angular = 0.0;
+  }
+  command_linear_ = std::clamp(linear, -r.max_linear_speed, r.max_linear_speed);
+  command_angular_ = std::clamp(angular, -r.max_angular_speed, r.max_angular_speed);
+  command_expiry_ = time_ + r.cmd_vel_timeout;
+}
+
+bool Simulation::kidnap(const Pose2& pose, std::string* message)
+{
+  if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.theta))
+  {
+    *message = "the pose must be finite";
+    return false;
+  }
+  if (!robotFits(pose.position()))
+  {
+    *message = "pose " + formatPoint(pose.position()) + " is not free for a robot of radius " +
+               std::to_string(config_.robot.radius) + " m (wall or obstacle)";
+    return false;
+  }
+  true_pose_ = Pose2(pose.x, pose.y, wrapAngle(pose.theta));
+  linear_velocity_ = 0.0;
+  angular_velocity_ = 0.0;
+  command_expiry_ = -1.0;
+  if (config_.robot.motion == RobotMotion::Waypoints)
+  {
+    // Resume the loop at a waypoint reachable in a straight line, else turn in place.
+    robot_waypoints_enabled_ = false;
+    const auto& points = config_.robot.waypoints;
+    for (std::size_t k = 0; k < points.size() && !robot_waypoints_enabled_; ++k)
+    {
+      const std::size_t i = (robot_waypoint_ + k) % points.size();
+      if (pathClearOfWalls(true_pose_.position(), points[i], config_.robot.radius + config_.clearance))
+      {
+        robot_waypoint_ = i;
+        robot_waypoints_enabled_ = true;
+      }
+    }
+  }
+  *message = "kidnapped to " + formatPoint(true_pose_.position());
+  return true;
+}
+
+bool Simulation::kidnapRandom(Pose2* pose, std::string* message)
+{
+  Pose2 target;
+  if (!randomFreePose(&target))
+  {
+    *message = "no free pose found";
+    return false;
+  }
+  *pose = target;
+  return kidnap(target, message);
+}
+
+void Simulation::reset()
+{
+  true_pose_ = initial_pose_;
+  odom_pose_ = Pose2();
+  obstacles_ = initial_obstacles_;
+  robot_waypoint_ = initial_waypoint_;
+  robot_waypoints_enabled_ = true;
+  linear_velocity_ = 0.0;
+  angular_velocity_ = 0.0;
+  command_expiry_ = -1.0;
+  syncScene();
+}
+
+void Simulation::step(StepOutput* out)
+{
+  out->readings.clear();
+  out->has_scan = false;
+  out->odometry_due = false;
+  ++steps_;
+  time_ = static_cast<double>(steps_) * dt_;
+  moveObstacles();
+  syncScene();
+  const Pose2 before = true_pose_;
+  moveRobot();
+  updateOdometry(before);
+  takeReadings(out);
+  if (time_ + kTimeEpsilon >= next_odom_time_)
+  {
+    out->odometry_due = true;
+    const double period = config_.odometry.rate > 0.0 ? 1.0 / config_.odometry.rate : dt_;
+    next_odom_time_ = std::max(next_odom_time_ + period, time_ + 0.5 * dt_);
+  }
+}
+
+void Simulation::moveRobot()
+{
+  const RobotConfig& r = config_.robot;
+  linear_velocity_ = 0.0;
+  angular_velocity_ = 0.0;
+  double turn = 0.0;
+  double advance = 0.0;
+  bool reached = false;
+  if (r.motion == RobotMotion::Rotate || (r.motion == RobotMotion::Waypoints && !robot_waypoints_enabled_))
+  {
+    turn = r.angular_speed * dt_;
+  }
+  else if (r.motion == RobotMotion::Waypoints)
+  {
+    const Vec2 d = r.waypoints[robot_waypoint_] - true_pose_.position();
+    const double distance = d.norm();
+    const double error = distance > 1e-9 ? angleDiff(std::atan2(d.y(), d.x()), true_pose_.theta) : 0.0;
+    const double max_turn = std::abs(r.angular_speed) * dt_;
+    if (std::abs(error) > 1e-6)
+    {
+      turn = std::clamp(error, -max_turn, max_turn);
+    }
+    else
+    {
+      advance = std::min(distance, r.linear_speed * dt_);
+      reached = distance <= r.linear_speed * dt_;
+    }
+  }
+  else if (time_ <= command_expiry_ + kTimeEpsilon)
+  {
+    turn = command_angular_ * dt_;
+    advance = command_linear_ * dt_;
+  }
+  const double mid_heading = true_pose_.theta + 0.5 * turn;
+  const Vec2 target = true_pose_.position() + advance * Vec2(std::cos(mid_heading), std::sin(mid_heading));
+  if (advance != 0.0 && robotFits(target))
+  {
+    true_pose_.x = target.x();
+    true_pose_.y = target.y();
+    linear_velocity_ = advance / dt_;
+  }
+  else
+  {
+    reached = reached && advance == 0.0;  // blocked: keep aiming at the same waypoint
+  }
+  if (reached)
+  {
+    robot_waypoint_ = (robot_waypoint_ + 1) % r.waypoints.size();
+  }
+  true_pose_.theta = wrapAngle(true_pose_.theta + turn);
+  angular_velocity_ = turn / dt_;
+}
+
+void Simulation::updateOdometry(const Pose2& before)
+{
+  Pose2 delta = between(before, true_pose_);
+  const OdometryConfig& o = config_.odometry;
+  const double travel = std::hypot(delta.x, delta.y);
+  if (o.translation_noise > 0.0 && travel > 0.0)
+  {
+    std::normal_distribution<double> n(0.0, o.translation_noise * std::sqrt(0.5 * travel));
+    delta.x += n(rng_);
+    delta.y += n(rng_);
+  }
+  if (o.rotation_noise > 0.0 && delta.theta != 0.0)
+  {
+    std::normal_distribution<double> n(0.0, o.rotation_noise * std::sqrt(std::abs(delta.theta)));
+    delta.theta += n(rng_);
+  }
+  odom_pose_ = compose(odom_pose_, delta);
+}
+
+double Simulation::noisyRange(const SceneHit& hit, double min_range, double max_range, double sigma)
+{
+  if (hit.kind == SceneHit::Kind::None)
+  {
+    return kInf;
+  }
+  if (hit.distance < min_range)
+  {
+    return -kInf;
+  }
+  double range = hit.distance;
+  if (sigma > 0.0)
+  {
+    std::normal_distribution<double> n(0.0, sigma);
+    range += n(rng_);
+  }
+  return std::clamp(range, min_range, max_range);
+}
+
+SimReading Simulation::readSensor(int index)
+{
+  const SensorConfig& s = config_.sensors[static_cast<std::size_t>(index)];
+  SimReading reading;
+  reading.sensor = index;
+  reading.time = time_;
+  reading.sensor_pose = compose(true_pose_, s.mount);
+  const SceneHit hit = scene_.cast(reading.sensor_pose, s.max_range);
+  reading.kind = hit.kind;
+  reading.obstacle = hit.obstacle;
+  reading.true_range = hit.distance;
+  reading.map_range = hit.map_distance <= s.max_range ? hit.map_distance : kInf;
+  reading.range = noisyRange(hit, s.min_range, s.max_range, s.noise_sigma);
+  if (s.dropout > 0.0)
+  {
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    reading.dropped = u(rng_) < s.dropout;
+  }
+  return reading;
+}
+
+void Simulation::takeReadings(StepOutput* out)
+{
+  for (std::size_t i = 0; i < config_.sensors.size(); ++i)
+  {
+    if (time_ + kTimeEpsilon >= next_sensor_time_[i])
+    {
+      out->readings.push_back(readSensor(static_cast<int>(i)));
+      next_sensor_time_[i] = std::max(next_sensor_time_[i] + 1.0 / config_.sensors[i].rate, time_ + 0.5 * dt_);
+    }
+  }
+  const ScanConfig& sc = config_.scan;
+  if (sc.enabled && time_ + kTimeEpsilon >= next_scan_time_)
+  {
+    next_scan_time_ = std::max(next_scan_time_ + 1.0 / sc.rate, time_ + 0.5 * dt_);
+    out->has_scan = true;
+    SimScan& scan = out->scan;
+    scan.time = time_;
+    scan.sensor_pose = compose(true_pose_, sc.mount);
+    scan.ranges.resize(static_cast<std::size_t>(sc.beams));
+    scan.kinds.resize(static_cast<std::size_t>(sc.beams));
+    for (int b = 0; b < sc.beams; ++b)
+    {
+      const double angle = -kPi + kTwoPi * b / sc.beams;
+      const SceneHit hit = scene_.cast(compose(scan.sensor_pose, Pose2(0.0, 0.0, angle)), sc.max_range);
+      scan.ranges[static_cast<std::size_t>(b)] = noisyRange(hit, sc.min_range, sc.max_range, sc.noise_sigma);
+      scan.kinds[static_cast<std::size_t>(b)] = hit.kind;
+    }
+  }
+}
+
+}  // namespace core
+}  // namespace fdml_localization

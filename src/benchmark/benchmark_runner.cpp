@@ -19,7 +19,7 @@ constexpr int kPaperKPrime = 6;
 /// epsilon = 2 m, and its FDML baseline has no agreement filter at all; both return every
 /// candidate and are scored on the nearest one.
 constexpr double kPaperAgreementTolerance = 2.0;
-constexpr double kNoAgreementFilter = 1e9;
+constexpr double kNoAgreementFilter = kMaxAgreementTolerance;
 constexpr int kAllCandidates = 1000000;
 
 std::string joinIssues(const std::string& what, const std::vector<std::string>& issues)
@@ -37,6 +37,7 @@ std::string joinIssues(const std::string& what, const std::vector<std::string>& 
 std::vector<std::string> validate(const BenchConfig& c)
 {
   std::vector<std::string> issues = validate(c.protocol);
+  const int k = c.protocol.readings;
   if (c.scenes.empty())
   {
     issues.push_back("no scene: give at least one --map or --random");
@@ -63,13 +64,6 @@ std::vector<std::string> validate(const BenchConfig& c)
   {
     issues.push_back("resolution (n) list is empty");
   }
-  for (int n : c.resolutions)
-  {
-    if (n < 16 || n > 1024)
-    {
-      issues.push_back("resolution (n) = " + std::to_string(n) + " must be in [16, 1024]");
-    }
-  }
   if (c.trials < 1 || c.trials > 1000000)
   {
     issues.push_back("trials = " + std::to_string(c.trials) + " must be in [1, 1000000]");
@@ -78,15 +72,33 @@ std::vector<std::string> validate(const BenchConfig& c)
   {
     issues.push_back("method list is empty");
   }
-  const int k = c.protocol.readings;
-  if (c.min_inliers != 0 && (c.min_inliers < 3 || c.min_inliers > k))
+  if (c.min_inliers > k)  // the lower bound is the core's (below)
   {
     issues.push_back("min-inliers (k') = " + std::to_string(c.min_inliers) +
                      " must be 'auto' or in [3, k = " + std::to_string(k) + "]");
   }
-  if (c.threads < 0)
+  // The localizer options of every run: one validation (the core's), under the tool's flag names.
+  const auto flag = [k](const std::string& option) {
+    if (option == "k")
+    {
+      return "k = " + std::to_string(k);
+    }
+    std::string name = "--" + option;
+    std::replace(name.begin(), name.end(), '_', '-');
+    return name;
+  };
+  for (Method method : c.methods)
   {
-    issues.push_back("threads = " + std::to_string(c.threads) + " must be >= 0 (0 = all cores)");
+    for (int n : c.resolutions)
+    {
+      for (const std::string& issue : validate(benchLocalizerOptions(c, method, n), flag))
+      {
+        if (std::find(issues.begin(), issues.end(), issue) == issues.end())
+        {
+          issues.push_back(issue);
+        }
+      }
+    }
   }
   return issues;
 }

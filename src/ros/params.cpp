@@ -131,35 +131,20 @@ std::vector<std::string> validate(const Params& p)
   check(&errors, knownName(p.engine, core::parseEngine), "engine", quoted(p.engine), "\"voxel\" or \"adaptive\"");
   check(&errors, knownName(p.method, core::parseMethod), "method", quoted(p.method),
         "\"robust\", \"paper\" or \"baseline\"");
-  // The voxel engine's table holds n x n x n_theta samples; the adaptive engine goes far finer.
-  const int max_resolution = p.engine == "adaptive" ? core::kMaxAdaptiveResolution : core::kMaxVoxelResolution;
-  const std::string range = "[16, " + std::to_string(max_resolution) + "] for ~engine " + p.engine;
-  check(&errors, p.resolution >= 16 && p.resolution <= max_resolution, "resolution", p.resolution,
-        "an integer in " + range);
-  check(&errors, p.theta_resolution == 0 || (p.theta_resolution >= 16 && p.theta_resolution <= max_resolution),
-        "theta_resolution", p.theta_resolution, "0 (= ~resolution) or an integer in " + range);
-  check(&errors, p.min_inliers == 0 || (p.min_inliers >= 3 && p.min_inliers <= k), "min_inliers", p.min_inliers,
+  check(&errors, p.localizer.min_inliers <= k, "min_inliers", p.localizer.min_inliers,
         "0 (automatic) or an integer in [3, ~measurements_per_batch]");
-  check(&errors, p.method != "paper" || p.min_inliers != 0, "min_inliers", p.min_inliers,
-        "a fixed k' in [3, ~measurements_per_batch] with ~method paper (automatic k' is not the paper's)");
-  check(&errors, finiteIn(p.agreement_tolerance, 0.0, 10.0) && p.agreement_tolerance > 0.0, "agreement_tolerance",
-        p.agreement_tolerance, "(0, 10] m");
-  check(&errors, finiteIn(p.uniqueness_distance, 0.0, 100.0), "uniqueness_distance", p.uniqueness_distance,
-        "[0, 100] m");
-  check(&errors, finiteIn(p.uniqueness_angle, 0.0, 3.14159265358979323846), "uniqueness_angle", p.uniqueness_angle,
-        "[0, pi] rad");
-  check(&errors, finiteIn(p.range_tolerance, 0.0, 10.0), "range_tolerance", p.range_tolerance, "[0, 10] m");
-  check(&errors, p.max_candidates >= 1 && p.max_candidates <= 10000, "max_candidates", p.max_candidates,
-        "an integer in [1, 10000]");
-  check(&errors, p.threads >= 0 && p.threads <= 1024, "threads", p.threads, "0 (all cores) or an integer in [1, 1024]");
-  check(&errors, p.max_boxes >= 1000, "max_boxes", p.max_boxes, "an integer >= 1000");
-  check(&errors, finiteIn(p.deadline, 0.0, 3600.0), "deadline", p.deadline, "0 (none) or (0, 3600] s");
+  // The core options: one validation, reported under the parameters' names (k is the batch size).
+  const auto parameter = [](const std::string& n) { return n == "k" ? "~measurements_per_batch" : "~" + n; };
+  for (const std::string& error : core::validate(toLocalizerOptions(p), parameter))
+  {
+    errors.push_back(error);
+  }
   return errors;
 }
 
 core::LocalizerOptions toLocalizerOptions(const Params& p)
 {
-  core::LocalizerOptions options;
+  core::LocalizerOptions options = p.localizer;
   // Unknown names keep the defaults; validate() reports them.
   if (knownName(p.engine, core::parseEngine))
   {
@@ -169,18 +154,6 @@ core::LocalizerOptions toLocalizerOptions(const Params& p)
   {
     options.method = core::parseMethod(p.method);
   }
-  options.resolution = p.resolution;
-  options.theta_resolution = p.theta_resolution;
-  options.min_inliers = p.min_inliers;
-  options.agreement_tolerance = p.agreement_tolerance;
-  options.uniqueness_distance = p.uniqueness_distance;
-  options.uniqueness_angle = p.uniqueness_angle;
-  options.range_tolerance = p.range_tolerance;
-  options.max_candidates = p.max_candidates;
-  options.threads = p.threads;
-  options.cache_dir = p.cache_dir;
-  options.max_boxes = p.max_boxes;
-  options.deadline = p.deadline;
   return options;
 }
 
@@ -207,11 +180,11 @@ Params withGridTolerances(const Params& params, double resolution)
   }
   if (!p.range_tolerance_set)
   {
-    p.range_tolerance = std::max(p.range_tolerance, resolution);
+    p.localizer.range_tolerance = std::max(p.localizer.range_tolerance, resolution);
   }
   if (!p.agreement_tolerance_set)
   {
-    p.agreement_tolerance = std::max(p.agreement_tolerance, 2.0 * resolution);
+    p.localizer.agreement_tolerance = std::max(p.localizer.agreement_tolerance, 2.0 * resolution);
   }
   return p;
 }
@@ -264,14 +237,16 @@ std::string describe(const Params& p)
       << "  frames: global " << p.global_frame_id << ", odom " << p.odom_frame_id << ", base " << p.base_frame_id
       << "\n"
       << "  topics: range " << p.range_topic << ", scan " << p.scan_topic << "\n"
-      << "  engine: " << p.engine << ", method: " << p.method << ", resolution: " << p.resolution
-      << ", theta_resolution: " << p.theta_resolution << ", min_inliers: " << p.min_inliers << "\n"
-      << "  agreement_tolerance: " << p.agreement_tolerance << " m" << (p.agreement_tolerance_set ? "" : " (default)")
-      << ", uniqueness_distance: " << p.uniqueness_distance << " m, uniqueness_angle: " << p.uniqueness_angle
-      << " rad, range_tolerance: " << p.range_tolerance << " m" << (p.range_tolerance_set ? "" : " (default)") << "\n"
-      << "  max_candidates: " << p.max_candidates << ", threads: " << p.threads << ", max_boxes: " << p.max_boxes
-      << ", deadline: " << p.deadline << " s\n"
-      << "  cache_dir: " << (p.cache_dir.empty() ? "(none)" : p.cache_dir);
+      << "  engine: " << p.engine << ", method: " << p.method << ", resolution: " << p.localizer.resolution
+      << ", theta_resolution: " << p.localizer.theta_resolution << ", min_inliers: " << p.localizer.min_inliers << "\n"
+      << "  agreement_tolerance: " << p.localizer.agreement_tolerance << " m"
+      << (p.agreement_tolerance_set ? "" : " (default)") << ", uniqueness_distance: " << p.localizer.uniqueness_distance
+      << " m, uniqueness_angle: " << p.localizer.uniqueness_angle
+      << " rad, range_tolerance: " << p.localizer.range_tolerance << " m" << (p.range_tolerance_set ? "" : " (default)")
+      << "\n"
+      << "  max_candidates: " << p.localizer.max_candidates << ", threads: " << p.localizer.threads
+      << ", max_boxes: " << p.localizer.max_boxes << ", deadline: " << p.localizer.deadline << " s\n"
+      << "  cache_dir: " << (p.localizer.cache_dir.empty() ? "(none)" : p.localizer.cache_dir);
   return out.str();
 }
 
@@ -302,26 +277,28 @@ Params loadParams(const ros::NodeHandle& nh)
   nh.param("scan_topic", p.scan_topic, p.scan_topic);
   nh.param("engine", p.engine, p.engine);
   nh.param("method", p.method, p.method);
-  nh.param("resolution", p.resolution, p.resolution);
-  nh.param("theta_resolution", p.theta_resolution, p.theta_resolution);
-  nh.param("min_inliers", p.min_inliers, p.min_inliers);
+  nh.param("resolution", p.localizer.resolution, p.localizer.resolution);
+  nh.param("theta_resolution", p.localizer.theta_resolution, p.localizer.theta_resolution);
+  nh.param("min_inliers", p.localizer.min_inliers, p.localizer.min_inliers);
   p.agreement_tolerance_set = nh.hasParam("agreement_tolerance");
-  nh.param("agreement_tolerance", p.agreement_tolerance, p.agreement_tolerance);
-  nh.param("uniqueness_distance", p.uniqueness_distance, p.uniqueness_distance);
-  nh.param("uniqueness_angle", p.uniqueness_angle, p.uniqueness_angle);
+  nh.param("agreement_tolerance", p.localizer.agreement_tolerance, p.localizer.agreement_tolerance);
+  nh.param("uniqueness_distance", p.localizer.uniqueness_distance, p.localizer.uniqueness_distance);
+  nh.param("uniqueness_angle", p.localizer.uniqueness_angle, p.localizer.uniqueness_angle);
   p.range_tolerance_set = nh.hasParam("range_tolerance");
-  nh.param("range_tolerance", p.range_tolerance, p.range_tolerance);
-  nh.param("max_candidates", p.max_candidates, p.max_candidates);
-  nh.param("threads", p.threads, p.threads);
-  nh.param("max_boxes", p.max_boxes, p.max_boxes);
-  nh.param("deadline", p.deadline, p.deadline);
+  nh.param("range_tolerance", p.localizer.range_tolerance, p.localizer.range_tolerance);
+  nh.param("max_candidates", p.localizer.max_candidates, p.localizer.max_candidates);
+  nh.param("threads", p.localizer.threads, p.localizer.threads);
+  int max_boxes = static_cast<int>(std::min<long>(p.localizer.max_boxes, 2147483647L));
+  nh.param("max_boxes", max_boxes, max_boxes);
+  p.localizer.max_boxes = max_boxes;
+  nh.param("deadline", p.localizer.deadline, p.localizer.deadline);
 
   const char* home_env = std::getenv("HOME");
   const char* ros_home_env = std::getenv("ROS_HOME");
   const std::string home = home_env ? home_env : "";
   const std::string ros_home = ros_home_env ? ros_home_env : "";
-  nh.param("cache_dir", p.cache_dir, defaultCacheDir(expandUser(ros_home, home), home));
-  p.cache_dir = expandUser(p.cache_dir, home);
+  nh.param("cache_dir", p.localizer.cache_dir, defaultCacheDir(expandUser(ros_home, home), home));
+  p.localizer.cache_dir = expandUser(p.localizer.cache_dir, home);
   return p;
 }
 

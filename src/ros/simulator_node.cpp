@@ -3,6 +3,7 @@
 #include "fdml_localization/ReadingTruth.h"
 #include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/ros/conversions.h"
+#include "fdml_localization/ros/markers.h"
 #include "fdml_localization/ros/param_utils.h"
 
 #include <geometry_msgs/TransformStamped.h>

@@ -10,10 +10,12 @@
 // and one candidate per line, best first; exit 0 (also with no candidate), 2 on bad input.
 #include "fdml_localization/core/localization/localizer.h"
 #include "fdml_localization/core/map/map_io.h"
+#include "fdml_localization/core/localization/ranking.h"
 #include "fdml_localization/core/util/text_parsing.h"
 
 #include <cerrno>
 #include <cmath>
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -234,13 +236,33 @@ Arguments parseArguments(int argc, char** argv)
   return args;
 }
 
+/// One row per candidate; `unambiguous` is 1 on the best row when core::isUnambiguous() holds.
+/// The command-line flag of a core option (core::validate() names options, the user set flags).
+std::string flagName(const std::string& option)
+{
+  if (option == "agreement_tolerance")
+  {
+    return "--tolerance";
+  }
+  if (option == "k")
+  {
+    return "the number of readings";
+  }
+  std::string flag = "--" + option;
+  std::replace(flag.begin(), flag.end(), '_', '-');
+  return flag;
+}
+
 void printResult(const core::Result& result)
 {
-  std::printf("rank,x,y,theta,inliers,rms\n");
+  std::printf("rank,x,y,theta,inliers,rms,unambiguous\n");
+  const bool unambiguous = core::isUnambiguous(result);
   int rank = 1;
   for (const core::Candidate& c : result.candidates)
   {
-    std::printf("%d,%.6f,%.6f,%.6f,%d,%.6g\n", rank++, c.pose.x, c.pose.y, c.pose.theta, c.inliers, c.rms_residual);
+    std::printf("%d,%.6f,%.6f,%.6f,%d,%.6g,%d\n", rank, c.pose.x, c.pose.y, c.pose.theta, c.inliers, c.rms_residual,
+                rank == 1 && unambiguous ? 1 : 0);
+    ++rank;
   }
   std::fflush(stdout);
 }
@@ -262,7 +284,7 @@ int main(int argc, char** argv)
   try
   {
     const Arguments args = parseArguments(argc, argv);
-    const std::vector<std::string> problems = core::validate(args.options);
+    const std::vector<std::string> problems = core::validate(args.options, flagName);
     if (!problems.empty())
     {
       std::string text = "invalid options:";

@@ -1,6 +1,8 @@
 // Tests of the ROS conversion helpers and parameter utilities (no roscore needed): the
 // simulator's, then the localizer node's (round trips and REP-117 semantics).
 #include "fdml_localization/ros/conversions.h"
+#include "fdml_localization/ros/markers.h"
+#include "fdml_localization/ros/sensor_input.h"
 #include "fdml_localization/ros/param_utils.h"
 
 #include <gtest/gtest.h>

@@ -67,20 +67,20 @@ TEST(Params, EachOutOfRangeValueNamesItsParameterAndRange)
     { "range_topic", [](Params& p) { p.range_topic = ""; }, "non-empty" },
     { "engine", [](Params& p) { p.engine = "quantum"; }, "\"voxel\" or \"adaptive\"" },
     { "method", [](Params& p) { p.method = "magic"; }, "\"robust\", \"paper\" or \"baseline\"" },
-    { "resolution", [](Params& p) { p.resolution = 15; }, "[16, 1024]" },
-    { "resolution", [](Params& p) { p.resolution = 1025; }, "[16, 1024]" },
-    { "theta_resolution", [](Params& p) { p.theta_resolution = 15; }, "[16, 1024]" },
-    { "min_inliers", [](Params& p) { p.min_inliers = 2; }, "[3, ~measurements_per_batch]" },
-    { "min_inliers", [](Params& p) { p.min_inliers = 11; }, "[3, ~measurements_per_batch]" },
+    { "resolution", [](Params& p) { p.localizer.resolution = 15; }, "[16, 1024]" },
+    { "resolution", [](Params& p) { p.localizer.resolution = 1025; }, "[16, 1024]" },
+    { "theta_resolution", [](Params& p) { p.localizer.theta_resolution = 15; }, "[16, 1024]" },
+    { "min_inliers", [](Params& p) { p.localizer.min_inliers = 2; }, "[3, ~measurements_per_batch]" },
+    { "min_inliers", [](Params& p) { p.localizer.min_inliers = 11; }, "[3, ~measurements_per_batch]" },
     { "min_inliers", [](Params& p) { p.method = "paper"; }, "with ~method paper" },
-    { "agreement_tolerance", [](Params& p) { p.agreement_tolerance = 0.0; }, "(0, 10] m" },
-    { "uniqueness_distance", [](Params& p) { p.uniqueness_distance = -1.0; }, "[0, 100] m" },
-    { "uniqueness_angle", [](Params& p) { p.uniqueness_angle = 4.0; }, "[0, pi] rad" },
-    { "range_tolerance", [](Params& p) { p.range_tolerance = -0.01; }, "[0, 10] m" },
-    { "max_candidates", [](Params& p) { p.max_candidates = 0; }, "[1, 10000]" },
-    { "threads", [](Params& p) { p.threads = -1; }, "[1, 1024]" },
-    { "max_boxes", [](Params& p) { p.max_boxes = 10; }, ">= 1000" },
-    { "deadline", [](Params& p) { p.deadline = -1.0; }, "(0, 3600] s" },
+    { "agreement_tolerance", [](Params& p) { p.localizer.agreement_tolerance = 0.0; }, "(0, 1e6] m" },
+    { "uniqueness_distance", [](Params& p) { p.localizer.uniqueness_distance = -1.0; }, "[0, 100] m" },
+    { "uniqueness_angle", [](Params& p) { p.localizer.uniqueness_angle = 4.0; }, "[0, pi] rad" },
+    { "range_tolerance", [](Params& p) { p.localizer.range_tolerance = -0.01; }, "[0, 10] m" },
+    { "max_candidates", [](Params& p) { p.localizer.max_candidates = 0; }, "[1, 1000000]" },
+    { "threads", [](Params& p) { p.localizer.threads = -1; }, "[1, 1024]" },
+    { "max_boxes", [](Params& p) { p.localizer.max_boxes = 10; }, ">= 1000" },
+    { "deadline", [](Params& p) { p.localizer.deadline = -1.0; }, "(0, 3600] s" },
   };
   for (const Case& c : cases)
   {
@@ -96,11 +96,11 @@ TEST(Params, EachOutOfRangeValueNamesItsParameterAndRange)
 TEST(Params, EveryProblemIsReportedAtOnce)
 {
   Params params;
-  params.resolution = 3;
+  params.localizer.resolution = 3;
   params.mode = "x";
-  params.agreement_tolerance = -1.0;
+  params.localizer.agreement_tolerance = -1.0;
   params.measurements_per_batch = 10;
-  params.min_inliers = 12;
+  params.localizer.min_inliers = 12;
   const std::vector<std::string> errors = validate(params);
   EXPECT_EQ(errors.size(), 5u);
   for (const char* name : { "map_file", "resolution", "mode", "agreement_tolerance", "min_inliers" })
@@ -119,13 +119,13 @@ TEST(Params, LimitsAreInclusive)
   Params params = validParams();
   params.measurements_per_batch = 3;
   params.batch_stride = 3;
-  params.min_inliers = 3;
-  params.resolution = 16;
-  params.theta_resolution = 1024;
+  params.localizer.min_inliers = 3;
+  params.localizer.resolution = 16;
+  params.localizer.theta_resolution = 1024;
   params.measurements_per_batch = 255;
   EXPECT_TRUE(validate(params).empty());
   params.measurements_per_batch = 3;
-  params.theta_resolution = 16;
+  params.localizer.theta_resolution = 16;
   params.transform_tolerance = 0.0;
   params.mode = "continuous";
   EXPECT_TRUE(validate(params).empty());
@@ -136,18 +136,18 @@ TEST(Params, CoreOptionsAreCopied)
   Params params = validParams();
   params.engine = "adaptive";
   params.method = "baseline";
-  params.resolution = 64;
-  params.theta_resolution = 72;
-  params.min_inliers = 6;
-  params.agreement_tolerance = 0.03;
-  params.uniqueness_distance = 0.2;
-  params.uniqueness_angle = 0.3;
-  params.range_tolerance = 0.04;
-  params.max_candidates = 5;
-  params.threads = 2;
-  params.cache_dir = "/tmp/cache";
-  params.max_boxes = 5000;
-  params.deadline = 1.5;
+  params.localizer.resolution = 64;
+  params.localizer.theta_resolution = 72;
+  params.localizer.min_inliers = 6;
+  params.localizer.agreement_tolerance = 0.03;
+  params.localizer.uniqueness_distance = 0.2;
+  params.localizer.uniqueness_angle = 0.3;
+  params.localizer.range_tolerance = 0.04;
+  params.localizer.max_candidates = 5;
+  params.localizer.threads = 2;
+  params.localizer.cache_dir = "/tmp/cache";
+  params.localizer.max_boxes = 5000;
+  params.localizer.deadline = 1.5;
   const core::LocalizerOptions options = toLocalizerOptions(params);
   EXPECT_EQ(options.engine, core::Engine::Adaptive);
   EXPECT_EQ(options.method, core::Method::Baseline);
@@ -175,35 +175,35 @@ TEST(Params, AgreesWithTheCoreValidation)
   std::vector<std::function<void(Params&)>> accepted = {
     [](Params&) {},
     [](Params& p) {
-      p.resolution = 16;
-      p.theta_resolution = 1024;
-      p.min_inliers = 3;
+      p.localizer.resolution = 16;
+      p.localizer.theta_resolution = 1024;
+      p.localizer.min_inliers = 3;
     },
     [](Params& p) {
-      p.resolution = 1024;
-      p.theta_resolution = 16;
+      p.localizer.resolution = 1024;
+      p.localizer.theta_resolution = 16;
       p.measurements_per_batch = 255;
-      p.min_inliers = 255;
+      p.localizer.min_inliers = 255;
     },
     [](Params& p) {
       p.method = "paper";
-      p.min_inliers = 6;
+      p.localizer.min_inliers = 6;
     },
     [](Params& p) { p.method = "baseline"; },
     [](Params& p) {
       p.engine = "adaptive";
-      p.resolution = 100000;
-      p.theta_resolution = 7200;
+      p.localizer.resolution = 100000;
+      p.localizer.theta_resolution = 7200;
     },
     [](Params& p) {
-      p.agreement_tolerance = 10.0;
-      p.uniqueness_distance = 0.0;
-      p.uniqueness_angle = 0.0;
-      p.range_tolerance = 0.0;
-      p.max_candidates = 1;
-      p.threads = 1;
-      p.max_boxes = 1000;
-      p.deadline = 3600.0;
+      p.localizer.agreement_tolerance = 10.0;
+      p.localizer.uniqueness_distance = 0.0;
+      p.localizer.uniqueness_angle = 0.0;
+      p.localizer.range_tolerance = 0.0;
+      p.localizer.max_candidates = 1;
+      p.localizer.threads = 1;
+      p.localizer.max_boxes = 1000;
+      p.localizer.deadline = 3600.0;
     },
   };
   for (std::size_t i = 0; i < accepted.size(); ++i)
@@ -216,22 +216,22 @@ TEST(Params, AgreesWithTheCoreValidation)
   }
   // ... and every core option the core rejects, the node rejects first (naming the parameter).
   std::vector<std::function<void(Params&)>> rejected = {
-    [](Params& p) { p.resolution = 15; },
-    [](Params& p) { p.resolution = 1025; },
+    [](Params& p) { p.localizer.resolution = 15; },
+    [](Params& p) { p.localizer.resolution = 1025; },
     [](Params& p) {
       p.engine = "adaptive";
-      p.resolution = 100001;
+      p.localizer.resolution = 100001;
     },
-    [](Params& p) { p.theta_resolution = 15; },
-    [](Params& p) { p.min_inliers = 2; },
-    [](Params& p) { p.agreement_tolerance = 0.0; },
-    [](Params& p) { p.uniqueness_distance = -1.0; },
-    [](Params& p) { p.uniqueness_angle = -1.0; },
-    [](Params& p) { p.range_tolerance = -0.01; },
-    [](Params& p) { p.max_candidates = 0; },
-    [](Params& p) { p.threads = -1; },
-    [](Params& p) { p.max_boxes = 999; },
-    [](Params& p) { p.deadline = -1.0; },
+    [](Params& p) { p.localizer.theta_resolution = 15; },
+    [](Params& p) { p.localizer.min_inliers = 2; },
+    [](Params& p) { p.localizer.agreement_tolerance = 0.0; },
+    [](Params& p) { p.localizer.uniqueness_distance = -1.0; },
+    [](Params& p) { p.localizer.uniqueness_angle = -1.0; },
+    [](Params& p) { p.localizer.range_tolerance = -0.01; },
+    [](Params& p) { p.localizer.max_candidates = 0; },
+    [](Params& p) { p.localizer.threads = -1; },
+    [](Params& p) { p.localizer.max_boxes = 999; },
+    [](Params& p) { p.localizer.deadline = -1.0; },
     [](Params& p) { p.method = "paper"; },
   };
   for (std::size_t i = 0; i < rejected.size(); ++i)
@@ -386,28 +386,28 @@ TEST(Params, GridMapsWidenTheTolerancesTheUserDidNotSet)
   const Params defaults = validParams();
   // A 5 cm grid: one cell of range tolerance, two of agreement.
   Params grid = withGridTolerances(defaults, 0.05);
-  EXPECT_DOUBLE_EQ(grid.range_tolerance, 0.05);
-  EXPECT_DOUBLE_EQ(grid.agreement_tolerance, 0.10);
+  EXPECT_DOUBLE_EQ(grid.localizer.range_tolerance, 0.05);
+  EXPECT_DOUBLE_EQ(grid.localizer.agreement_tolerance, 0.10);
   // A fine 1 cm grid never goes below the defaults.
   grid = withGridTolerances(defaults, 0.01);
-  EXPECT_DOUBLE_EQ(grid.range_tolerance, defaults.range_tolerance);
-  EXPECT_DOUBLE_EQ(grid.agreement_tolerance, defaults.agreement_tolerance);
+  EXPECT_DOUBLE_EQ(grid.localizer.range_tolerance, defaults.localizer.range_tolerance);
+  EXPECT_DOUBLE_EQ(grid.localizer.agreement_tolerance, defaults.localizer.agreement_tolerance);
   // A polygon map (resolution 0) changes nothing.
   grid = withGridTolerances(defaults, 0.0);
-  EXPECT_EQ(grid.range_tolerance, defaults.range_tolerance);
-  EXPECT_EQ(grid.agreement_tolerance, defaults.agreement_tolerance);
+  EXPECT_EQ(grid.localizer.range_tolerance, defaults.localizer.range_tolerance);
+  EXPECT_EQ(grid.localizer.agreement_tolerance, defaults.localizer.agreement_tolerance);
   // Values the user set are kept, each on its own.
   Params set = validParams();
-  set.range_tolerance = 0.01;
+  set.localizer.range_tolerance = 0.01;
   set.range_tolerance_set = true;
   grid = withGridTolerances(set, 0.1);
-  EXPECT_EQ(grid.range_tolerance, 0.01);
-  EXPECT_DOUBLE_EQ(grid.agreement_tolerance, 0.2);
-  set.agreement_tolerance = 0.03;
+  EXPECT_EQ(grid.localizer.range_tolerance, 0.01);
+  EXPECT_DOUBLE_EQ(grid.localizer.agreement_tolerance, 0.2);
+  set.localizer.agreement_tolerance = 0.03;
   set.agreement_tolerance_set = true;
   grid = withGridTolerances(set, 0.1);
-  EXPECT_EQ(grid.range_tolerance, 0.01);
-  EXPECT_EQ(grid.agreement_tolerance, 0.03);
+  EXPECT_EQ(grid.localizer.range_tolerance, 0.01);
+  EXPECT_EQ(grid.localizer.agreement_tolerance, 0.03);
   // And they reach the core options.
   EXPECT_DOUBLE_EQ(toLocalizerOptions(withGridTolerances(defaults, 0.05)).range_tolerance, 0.05);
 }

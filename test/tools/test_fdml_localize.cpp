@@ -91,13 +91,19 @@ TEST_F(LocalizeCli, PrintsCandidatesBestFirst)
   std::string first;
   std::getline(lines, header);
   std::getline(lines, first);
-  EXPECT_EQ(header, "rank,x,y,theta,inliers,rms");
+  EXPECT_EQ(header, "rank,x,y,theta,inliers,rms,unambiguous");
   int rank = 0;
   double x = 0;
   double y = 0;
   double theta = 0;
   int inliers = 0;
-  ASSERT_EQ(std::sscanf(first.c_str(), "%d,%lf,%lf,%lf,%d", &rank, &x, &y, &theta, &inliers), 5) << first;
+  double rms = 0;
+  int unambiguous = -1;
+  ASSERT_EQ(std::sscanf(first.c_str(), "%d,%lf,%lf,%lf,%d,%lf,%d", &rank, &x, &y, &theta, &inliers, &rms, &unambiguous),
+            7)
+      << first;
+  // Ten exact readings in the asymmetric L-room: one place explains them all.
+  EXPECT_EQ(unambiguous, 1) << out;
   EXPECT_EQ(rank, 1);
   EXPECT_NEAR(x, truth.x, 1e-3);
   EXPECT_NEAR(y, truth.y, 1e-3);
@@ -116,7 +122,7 @@ TEST_F(LocalizeCli, NoCandidateStillExitsZero)
   std::string out;
   std::string err;
   EXPECT_EQ(run("--map " + map_path_ + " --resolution 24 " + write("far.csv", text), out, err), 0) << err;
-  EXPECT_EQ(out, "rank,x,y,theta,inliers,rms\n");
+  EXPECT_EQ(out, "rank,x,y,theta,inliers,rms,unambiguous\n");
 }
 
 TEST_F(LocalizeCli, BadInputExitsTwoWithAMessage)
@@ -134,13 +140,14 @@ TEST_F(LocalizeCli, BadInputExitsTwoWithAMessage)
     { "--map " + map_path_ + " " + write("few.csv", "gx,gy,gtheta,d\n0,0,0,1\n0,0,1,2\n"), "at least 3" },
     { "--map " + map_path_ + " " + write("cols.csv", "gx,gy,gtheta,d\n0,0,0\n"), "expected 4 fields" },
     { "--map " + map_path_ + " " + write("inf.csv", "gx,gy,gtheta,d\n0,0,0,inf\n0,0,1,1\n0,0,2,1\n"), "max range" },
-    { "--map " + map_path_ + " --resolution 8 " + good, "resolution 8" },
+    { "--map " + map_path_ + " --resolution 8 " + good, "--resolution = 8 is out of range" },
     { "--map " + map_path_ + " --resolution abc " + good, "not an integer" },
     { "--map " + map_path_ + " --min-inliers 11 " + good, "exceeds the number of readings" },
     { "--map " + map_path_ + " --min-inliers 2 " + good, "--min-inliers" },
     { "--map " + map_path_ + " --method fancy " + good, "unknown method" },
     { "--map " + map_path_ + " --engine warp " + good, "unknown engine" },
-    { "--map " + map_path_ + " --method paper " + good, "fixed min_inliers" },
+    { "--map " + map_path_ + " --method paper " + good, "a fixed k' in [3, the number of readings] with --method "
+                                                        "paper" },
     { "--map " + (dir_ / "missing.poly").string() + " " + good, "missing.poly" },
     { "--map " + map_path_ + " " + (dir_ / "missing.csv").string(), "missing.csv" },
     { "--map " + map_path_, "READINGS.csv" },

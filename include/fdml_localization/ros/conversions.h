@@ -1,16 +1,15 @@
 /**
  * @file conversions.h
  * @brief Free functions converting between the ROS-free core types and ROS messages:
- *        poses, yaw and quaternions, transforms, and visualization of maps and obstacles.
+ *        poses, yaw and quaternions, transforms, covariances, occupancy grids, readings and
+ *        results. Markers are in markers.h, sensor checks in sensor_input.h.
  *        Planar poses live in the z = 0 plane; units [m], [rad].
  */
 #pragma once
 
 #include "fdml_localization/core/geometry/ray_caster.h"
-#include "fdml_localization/simulation/scene.h"
 #include "fdml_localization/core/localization/localizer.h"
 #include "fdml_localization/core/map/grid/occupancy_grid.h"
-#include "fdml_localization/ros/reading_buffer.h"
 
 #include <fdml_localization/Candidate.h>
 #include <fdml_localization/LocalizationResult.h>
@@ -21,12 +20,8 @@
 #include <geometry_msgs/Pose2D.h>
 #include <geometry_msgs/Quaternion.h>
 #include <geometry_msgs/Transform.h>
-#include <sensor_msgs/LaserScan.h>
-#include <sensor_msgs/Range.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/time.h>
-#include <std_msgs/ColorRGBA.h>
-#include <visualization_msgs/MarkerArray.h>
 
 #include <Eigen/Core>
 
@@ -63,26 +58,6 @@ core::Pose2 fromTransformMsg(const geometry_msgs::Transform& transform);
 
 /// A point at height @p z [m].
 geometry_msgs::Point toPointMsg(const core::Vec2& p, double z = 0.0);
-
-/// A colour from components in [0, 1].
-std_msgs::ColorRGBA makeColor(float r, float g, float b, float a = 1.0f);
-
-/**
- * @brief The map's walls as markers: one LINE_LIST of every edge (namespace "map_walls").
- * @param map the polygon map
- * @param frame frame of the map
- * @param stamp header stamp
- */
-visualization_msgs::MarkerArray mapMarkers(const core::PolygonMap& map, const std::string& frame,
-                                           const ros::Time& stamp);
-
-/**
- * @brief Obstacles as markers, id = obstacle index, namespace "obstacles": a CYLINDER for a
- *        disc, a closed LINE_STRIP for a polygon. Markers of ids >= obstacles.size() up to
- *        @p previous_count are deleted.
- */
-visualization_msgs::MarkerArray obstacleMarkers(const std::vector<core::Obstacle>& obstacles, const std::string& frame,
-                                                const ros::Time& stamp, std::size_t previous_count = 0);
 
 /**
  * @brief Rasterizes the map: a cell is occupied (100) when a wall passes through it or its
@@ -129,37 +104,5 @@ fdml_localization::Candidate toCandidateMsg(const core::Candidate& candidate);
 fdml_localization::LocalizationResult toResultMsg(const core::Result& result);
 /// Copies drop counters into the result's drop_reasons / drop_counts (sorted by reason).
 void setDropCounts(const std::map<std::string, std::uint64_t>& drops, fdml_localization::LocalizationResult* msg);
-
-/**
- * @brief A sensor_msgs/Range as a reading, with REP-117 semantics: +inf is a no-return reading;
- *        NaN, -inf ("too close") and values outside [min_range, max_range] are dropped.
- * @param received arrival time on the node's clock [s]
- * @param[out] reading set when the reading is usable
- * @param[out] reason the drop reason (a drop_reason:: identifier) when it is not
- * @return true when usable
- */
-bool rangeToReading(const sensor_msgs::Range& msg, double received, TimedReading* reading, std::string* reason);
-
-/**
- * @brief Up to @p beams evenly spaced usable beams of a scan (REP-117 per beam, as for a
- *        Range: +inf is a no-return, NaN, -inf and values outside [range_min, range_max] are
- *        unusable). Beam i is stamped
- *        header.stamp + i * time_increment and posed (0, 0, angle_min + i * angle_increment)
- *        in the scan frame.
- * @param[out] drops counts of unusable beams by reason
- */
-std::vector<TimedReading> scanToReadings(const sensor_msgs::LaserScan& msg, int beams, double received,
-                                         std::map<std::string, std::uint64_t>* drops);
-
-/**
- * @brief The rays of a batch seen from a candidate pose: one LINE_LIST (namespace "rays", id 0)
- *        from each sensor pose q (+) g_i to its hit point, green for an inlier, red for an
- *        outlier, grey for a no-return ray (drawn to max_range, at most @p no_return_length m),
- *        and a SPHERE_LIST of the hit points (namespace "hits", id 1). Starts with a DELETEALL.
- * @param inlier_mask per reading (may be empty: every ray is then drawn as an inlier)
- */
-visualization_msgs::MarkerArray readingMarkers(const std::vector<core::Reading>& readings, const core::Pose2& pose,
-                                               const std::vector<bool>& inlier_mask, const std::string& frame_id,
-                                               const ros::Time& stamp, double no_return_length = 1.0);
 
 }  // namespace fdml_localization

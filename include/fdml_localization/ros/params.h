@@ -64,23 +64,14 @@ struct Params
   std::string range_topic = "range";
   std::string scan_topic = "scan";
 
-  // Core options (see core::LocalizerOptions for meanings).
+  // Core options: the parameters of the same names (~resolution, ~agreement_tolerance, ...) map
+  // onto core::LocalizerOptions, validated once by core::validate(); only the engine and method
+  // names are kept as text here, so that an unknown name can be reported.
   std::string engine = "voxel";          ///< ~engine: voxel | adaptive
   std::string method = "robust";         ///< ~method: robust | paper | baseline
-  int resolution = 100;                  ///< ~resolution
-  int theta_resolution = 0;              ///< ~theta_resolution: 0 = resolution, else in [16, 1024]
-  int min_inliers = 0;                   ///< ~min_inliers: k', 0 = automatic, else in [3, k] (fixed for paper)
-  double agreement_tolerance = 0.05;     ///< ~agreement_tolerance [m]
+  core::LocalizerOptions localizer;      ///< every other core option (engine, method: see above)
   bool agreement_tolerance_set = false;  ///< the user set ~agreement_tolerance (see withGridTolerances())
-  double uniqueness_distance = 0.1;      ///< ~uniqueness_distance [m]
-  double uniqueness_angle = 0.1;         ///< ~uniqueness_angle [rad]
-  double range_tolerance = 0.02;         ///< ~range_tolerance [m]
   bool range_tolerance_set = false;      ///< the user set ~range_tolerance (see withGridTolerances())
-  int max_candidates = 10;               ///< ~max_candidates
-  int threads = 0;                       ///< ~threads; 0 = all cores
-  std::string cache_dir;                 ///< ~cache_dir (expanded); empty = no disk cache
-  int max_boxes = 20000000;              ///< ~max_boxes: adaptive engine budget
-  double deadline = 0.0;                 ///< ~deadline [s]: adaptive engine budget per call; 0 = none
 };
 
 /**

@@ -5,6 +5,7 @@
 #include "fdml_localization/core/localization/voxel/voxel_engine.h"
 
 #include <cmath>
+#include <functional>
 #include <sstream>
 
 namespace fdml_localization
@@ -82,61 +83,40 @@ Engine parseEngine(const std::string& text)
   throw std::invalid_argument("unknown engine '" + text + "' (expected voxel or adaptive)");
 }
 
-std::vector<std::string> validate(const LocalizerOptions& o)
+std::vector<std::string> validate(const LocalizerOptions& o, const std::function<std::string(const std::string&)>& name)
 {
   std::vector<std::string> errors;
+  const auto named = [&](const char* option) { return name ? name(option) : std::string(option); };
+  const auto check = [&](bool ok, const char* option, const std::string& value, const std::string& allowed) {
+    if (!ok)
+    {
+      errors.push_back(named(option) + " = " + value + " is out of range; allowed: " + allowed);
+    }
+  };
+  const auto in = [](double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; };
   // The voxel engine holds n x n x n_theta samples; the adaptive engine only the boxes it keeps.
   const int max_resolution = o.engine == Engine::Voxel ? kMaxVoxelResolution : kMaxAdaptiveResolution;
   const std::string range = "[16, " + std::to_string(max_resolution) + "] for engine " + toString(o.engine);
-  if (o.resolution < 16 || o.resolution > max_resolution)
-  {
-    errors.push_back("resolution " + std::to_string(o.resolution) + " is outside " + range);
-  }
-  if (o.theta_resolution != 0 && (o.theta_resolution < 16 || o.theta_resolution > max_resolution))
-  {
-    errors.push_back("theta_resolution " + std::to_string(o.theta_resolution) + " is outside " + range +
-                     " (0 = resolution)");
-  }
-  if (o.min_inliers != 0 && (o.min_inliers < 3 || o.min_inliers > 255))
-  {
-    errors.push_back("min_inliers " + std::to_string(o.min_inliers) + " is outside [3, 255] (0 = automatic)");
-  }
-  if (o.method == Method::Paper && o.min_inliers == 0)
-  {
-    errors.push_back("method paper needs a fixed min_inliers (k' >= 3), not automatic");
-  }
-  if (!(o.agreement_tolerance > 0.0) || !std::isfinite(o.agreement_tolerance))
-  {
-    errors.push_back("agreement_tolerance " + number(o.agreement_tolerance) + " must be finite and > 0 [m]");
-  }
-  if (!(o.uniqueness_distance >= 0.0) || !std::isfinite(o.uniqueness_distance))
-  {
-    errors.push_back("uniqueness_distance " + number(o.uniqueness_distance) + " must be finite and >= 0 [m]");
-  }
-  if (!(o.uniqueness_angle >= 0.0) || !std::isfinite(o.uniqueness_angle))
-  {
-    errors.push_back("uniqueness_angle " + number(o.uniqueness_angle) + " must be finite and >= 0 [rad]");
-  }
-  if (!(o.range_tolerance >= 0.0) || !std::isfinite(o.range_tolerance))
-  {
-    errors.push_back("range_tolerance " + number(o.range_tolerance) + " must be finite and >= 0 [m]");
-  }
-  if (o.max_candidates < 1)
-  {
-    errors.push_back("max_candidates " + std::to_string(o.max_candidates) + " must be >= 1");
-  }
-  if (o.threads < 0)
-  {
-    errors.push_back("threads " + std::to_string(o.threads) + " must be >= 0 (0 = all cores)");
-  }
-  if (o.max_boxes < 1000)
-  {
-    errors.push_back("max_boxes " + std::to_string(o.max_boxes) + " must be >= 1000");
-  }
-  if (!(o.deadline >= 0.0) || !std::isfinite(o.deadline))
-  {
-    errors.push_back("deadline " + number(o.deadline) + " must be finite and >= 0 [s] (0 = none)");
-  }
+  check(o.resolution >= 16 && o.resolution <= max_resolution, "resolution", std::to_string(o.resolution),
+        "an integer in " + range);
+  check(o.theta_resolution == 0 || (o.theta_resolution >= 16 && o.theta_resolution <= max_resolution),
+        "theta_resolution", std::to_string(o.theta_resolution), "0 (= resolution) or an integer in " + range);
+  // k, the number of readings in a batch, is checked against k' per batch (validateReadings).
+  check(o.min_inliers == 0 || (o.min_inliers >= 3 && o.min_inliers <= 255), "min_inliers",
+        std::to_string(o.min_inliers), "0 (automatic) or an integer in [3, " + named("k") + "]");
+  check(o.method != Method::Paper || o.min_inliers != 0, "min_inliers", std::to_string(o.min_inliers),
+        "a fixed k' in [3, " + named("k") + "] with " + named("method") + " paper (automatic k' is not the paper's)");
+  check(in(o.agreement_tolerance, 0.0, kMaxAgreementTolerance) && o.agreement_tolerance > 0.0, "agreement_tolerance",
+        number(o.agreement_tolerance), "(0, 1e6] m (beyond the map's size: no agreement filter)");
+  check(in(o.uniqueness_distance, 0.0, 100.0), "uniqueness_distance", number(o.uniqueness_distance), "[0, 100] m");
+  check(in(o.uniqueness_angle, 0.0, kPi), "uniqueness_angle", number(o.uniqueness_angle), "[0, pi] rad");
+  check(in(o.range_tolerance, 0.0, 10.0), "range_tolerance", number(o.range_tolerance), "[0, 10] m");
+  check(o.max_candidates >= 1 && o.max_candidates <= 1000000, "max_candidates", std::to_string(o.max_candidates),
+        "an integer in [1, 1000000]");
+  check(o.threads >= 0 && o.threads <= 1024, "threads", std::to_string(o.threads),
+        "0 (all cores) or an integer in [1, 1024]");
+  check(o.max_boxes >= 1000, "max_boxes", std::to_string(o.max_boxes), "an integer >= 1000");
+  check(in(o.deadline, 0.0, 3600.0), "deadline", number(o.deadline), "0 (none) or (0, 3600] s");
   return errors;
 }
 

@@ -12,18 +12,6 @@ namespace
 {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-/// The ranking of betterCandidate() on evaluations.
-bool rankedBefore(int inliers_a, int contradicted_a, double rms_a, int inliers_b, int contradicted_b, double rms_b)
-{
-  const int net_a = inliers_a - contradicted_a;
-  const int net_b = inliers_b - contradicted_b;
-  if (net_a != net_b)
-  {
-    return net_a > net_b;
-  }
-  return contradicted_a != contradicted_b ? contradicted_a < contradicted_b : rms_a < rms_b;
-}
-
 bool evaluationBetter(const PoseEvaluation& a, const PoseEvaluation& b)
 {
   return rankedBefore(a.inliers, a.contradicted, a.rms, b.inliers, b.contradicted, b.rms);
@@ -343,40 +331,6 @@ Candidate refineSeed(const MapRayCaster& map, const Pose2& seed, const std::vect
   c.rms_residual = best.rms;
   c.covariance = best_cov;
   return c;
-}
-
-bool betterCandidate(const Candidate& a, const Candidate& b)
-{
-  return rankedBefore(a.inliers, a.contradicted, a.rms_residual, b.inliers, b.contradicted, b.rms_residual);
-}
-
-std::vector<Candidate> rankAndDeduplicate(std::vector<Candidate> candidates, double distance, double angle,
-                                          int max_candidates)
-{
-  std::stable_sort(candidates.begin(), candidates.end(), betterCandidate);
-  std::vector<Candidate> kept;
-  for (Candidate& c : candidates)
-  {
-    if (static_cast<int>(kept.size()) >= max_candidates)
-    {
-      break;
-    }
-    bool duplicate = false;
-    for (const Candidate& k : kept)
-    {
-      const double dd = std::hypot(c.pose.x - k.pose.x, c.pose.y - k.pose.y);
-      if (dd < distance && std::abs(angleDiff(c.pose.theta, k.pose.theta)) < angle)
-      {
-        duplicate = true;
-        break;
-      }
-    }
-    if (!duplicate)
-    {
-      kept.push_back(std::move(c));
-    }
-  }
-  return kept;
 }
 
 }  // namespace core

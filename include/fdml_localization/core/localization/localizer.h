@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -59,6 +60,9 @@ constexpr int kMaxVoxelResolution = 1024;
 /// Largest resolution of the adaptive engine (1 mm cells over a 100 m map).
 constexpr int kMaxAdaptiveResolution = 100000;
 
+/// Largest agreement tolerance [m]: beyond any map's size, i.e. no agreement filter (baseline).
+constexpr double kMaxAgreementTolerance = 1e6;
+
 /// Localizer options. validate() lists every out-of-range value.
 struct LocalizerOptions
 {
@@ -80,8 +84,15 @@ struct LocalizerOptions
   double deadline = 0.0;      ///< wall-time budget per call [s]; 0 = none
 };
 
-/// Every problem with the options, each naming the option and its allowed range.
-std::vector<std::string> validate(const LocalizerOptions& options);
+/**
+ * @brief The one validation of the options: every problem, each as "NAME = VALUE is out of
+ *        range; allowed: RANGE". ROS parameters and tool flags map onto the options and report
+ *        these errors under their own names.
+ * @param name maps an option's name (e.g. "resolution") to the caller's name for it (e.g.
+ *        "~resolution" or "--resolution"); empty = the option's own name
+ */
+std::vector<std::string> validate(const LocalizerOptions& options,
+                                  const std::function<std::string(const std::string&)>& name = {});
 
 /// Thrown by localize() for unusable input (NaN or negative ranges, too few readings, ...).
 class InvalidInput : public std::invalid_argument
@@ -128,7 +139,7 @@ struct StageTimes
 /// The outcome of one localize() call.
 struct Result
 {
-  std::vector<Candidate> candidates;  ///< best first: see betterCandidate() (candidate_refinement.h)
+  std::vector<Candidate> candidates;  ///< best first: see betterCandidate() (ranking.h)
   int readings_used = 0;
   int min_inliers_used = 0;  ///< k' actually used
   bool truncated = false;    ///< a search budget was reached (adaptive engine)

@@ -8,6 +8,7 @@
 #pragma once
 
 #include "fdml_localization/core/localization/localizer.h"
+#include "fdml_localization/core/localization/ranking.h"
 
 #include <Eigen/Core>
 
@@ -112,26 +113,6 @@ std::vector<double> vertexMargins(const MapRayCaster& map, const Pose2& pose, co
 /// A candidate at @p pose, verified but not polished.
 Candidate verifiedCandidate(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings,
                             double eps);
-
-/// Net consensus of a candidate: inliers minus the readings the map contradicts at its pose.
-inline int netConsensus(const Candidate& c)
-{
-  return c.inliers - c.contradicted;
-}
-
-/**
- * @brief Ranking order: the larger net consensus (inliers - contradicted) first, then fewer
- *        contradicted readings, then lower RMS residual. Without contradicted readings this is
- *        "most inliers, then lowest RMS".
- */
-bool betterCandidate(const Candidate& a, const Candidate& b);
-
-/**
- * @brief Sorts best first and drops every candidate closer than (@p distance [m], @p angle
- *        [rad]) to a better one kept before it; keeps at most @p max_candidates.
- */
-std::vector<Candidate> rankAndDeduplicate(std::vector<Candidate> candidates, double distance, double angle,
-                                          int max_candidates);
 
 }  // namespace core
 }  // namespace fdml_localization

@@ -1,8 +1,10 @@
-// AdaptiveEngine::localize: the box search, then the voxel engine's seed, polish and ranking
-// stages on the leaves (regional maxima per k', retries, maximum consensus).
+// The adaptive engine: the box search (adaptive_search.h), its leaves' plateaus as seeds of the
+// shared robust search (seed_search.h), or verified component centres (paper, baseline).
 #include "fdml_localization/core/localization/adaptive/adaptive_engine.h"
 
+#include "fdml_localization/core/localization/ranking.h"
 #include "fdml_localization/core/localization/robust_search.h"
+#include "fdml_localization/core/localization/seed_search.h"
 #include "fdml_localization/core/util/stopwatch.h"
 
 #include <omp.h>
@@ -17,10 +19,6 @@ namespace core
 {
 namespace
 {
-/// Seeds retried from other leaves of their plateau when no seed reaches the level.
-constexpr long kRetriedSeeds = 32;
-/// ... of which this many also get a local lattice search around the seed.
-constexpr long kLocallySearchedSeeds = 8;
 /// Distinct seeds taken from one plateau.
 constexpr std::size_t kSeedsPerPlateau = 3;
 /// ... from plateaus of at least this many leaves (smaller ones give one seed).
@@ -92,23 +90,80 @@ std::vector<Pose2> plateauSeeds(const MapRayCaster& map, const std::vector<LeafB
   return seeds;
 }
 
-double medianFiniteRange(const std::vector<Reading>& readings)
+/// The adaptive engine's seeds, level by level: the best-agreeing distinct leaves of each
+/// plateau of leaves whose boxes may explain `level` readings (leafMaxima()).
+class LeafSeeds : public SeedSource
 {
-  std::vector<double> finite;
-  for (const Reading& r : readings)
+public:
+  LeafSeeds(const MapRayCaster& map, AdaptiveSearch& search, const std::vector<Reading>& readings, double cell_xy,
+            double cell_theta, double gate, int threads, StageTimes& times)
+    : map_(map)
+    , search_(search)
+    , readings_(readings)
+    , cell_xy_(cell_xy)
+    , cell_theta_(cell_theta)
+    , gate_(gate)
+    , threads_(threads)
+    , times_(times)
+  {}
+
+  std::vector<SearchSeed> seedsAt(int level) override
   {
-    if (std::isfinite(r.range))
+    auto stage = std::chrono::steady_clock::now();
+    const AdaptiveSearchResult& found = search_.run(level);
+    truncated_ = found.truncated;
+    times_.preimages += secondsSince(stage);
+    stage = std::chrono::steady_clock::now();
+    const std::int64_t theta_cells = std::max<std::int64_t>(1, std::llround(kTwoPi / cell_theta_));
+    const std::vector<LeafCluster> plateaus = leafMaxima(found.leaves, level, theta_cells);
+    times_.components += secondsSince(stage);
+    stage = std::chrono::steady_clock::now();
+    std::vector<std::vector<Pose2>> starts(plateaus.size());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads_) if (plateaus.size() >= 4)
+    for (long c = 0; c < static_cast<long>(plateaus.size()); ++c)
     {
-      finite.push_back(r.range);
+      starts[c] = plateauSeeds(map_, found.leaves, plateaus[c], readings_, gate_, 4.0 * cell_xy_, 4.0 * cell_theta_,
+                               plateaus[c].members.size() >= kLargePlateau ? kSeedsPerPlateau : 1);
     }
+    std::vector<SearchSeed> seeds;
+    for (std::size_t c = 0; c < plateaus.size(); ++c)
+    {
+      const LeafCluster& cluster = plateaus[c];
+      const std::size_t n = cluster.members.size();
+      for (const Pose2& start : starts[c])
+      {
+        SearchSeed seed;
+        seed.start = start;
+        seed.hypothesis = hypothesisOf(found.leaves[cluster.representative], readings_.size());
+        seed.promised = level;
+        seed.region = c;
+        seed.support = static_cast<double>(cluster.size);
+        seed.retry_starts = { found.leaves[cluster.representative].box.centre(),
+                              found.leaves[cluster.members[n / 3]].box.centre(),
+                              found.leaves[cluster.members[(2 * n) / 3]].box.centre() };
+        seeds.push_back(std::move(seed));
+      }
+    }
+    times_.verification += secondsSince(stage);
+    return seeds;
   }
-  if (finite.empty())
+
+  bool exhausted() const override
   {
-    return 1.0;
+    return truncated_;
   }
-  std::nth_element(finite.begin(), finite.begin() + finite.size() / 2, finite.end());
-  return finite[finite.size() / 2];
-}
+
+private:
+  const MapRayCaster& map_;
+  AdaptiveSearch& search_;
+  const std::vector<Reading>& readings_;
+  double cell_xy_;
+  double cell_theta_;
+  double gate_;
+  int threads_;
+  StageTimes& times_;
+  bool truncated_ = false;
+};
 }  // namespace
 
 Result AdaptiveEngine::localize(const std::vector<Reading>& readings)
@@ -174,163 +229,14 @@ void AdaptiveEngine::localizeFixed(AdaptiveSearch& search, const std::vector<Rea
 
 void AdaptiveEngine::localizeRobust(AdaptiveSearch& search, const std::vector<Reading>& readings, Result& result)
 {
-  const int k = static_cast<int>(readings.size());
-  const bool automatic = options_.min_inliers <= 0;
-  const int lowest = automatic ? 3 : options_.min_inliers;
-  const std::int64_t theta_cells = std::max<std::int64_t>(1, std::llround(kTwoPi / cell_theta_));
   const int threads = options_.threads > 0 ? options_.threads : omp_get_max_threads();
-
-  RefinementSettings settings;
-  settings.agreement_tolerance = options_.agreement_tolerance;
-  settings.robust_scale =
-      std::max(options_.agreement_tolerance, 0.5 * cell_xy_ + 0.5 * cell_theta_ * medianFiniteRange(readings));
-  settings.noise_sigma = std::max(options_.range_tolerance / std::sqrt(3.0), 1e-4);
-  settings.seed_position_error = 1.5 * cell_xy_;
-  settings.seed_angle_error = cell_theta_;
-  // Seeds where fewer than (level - 2) readings agree even this loosely are not polished.
-  const double loose_gate = 3.0 * settings.robust_scale;
-
-  std::vector<Candidate> seeds;
-  int used_level = lowest;
-  for (int level = k; level >= lowest; --level)
-  {
-    auto stage = std::chrono::steady_clock::now();
-    const AdaptiveSearchResult& found = search.run(level);
-    result.times.preimages += secondsSince(stage);
-    stage = std::chrono::steady_clock::now();
-    const std::vector<LeafCluster> plateaus = leafMaxima(found.leaves, level, theta_cells);
-    result.times.components += secondsSince(stage);
-    // Seeds: the best-agreeing distinct leaves of each plateau (a copy of the plateau per seed).
-    stage = std::chrono::steady_clock::now();
-    std::vector<std::vector<Pose2>> plateau_seeds(plateaus.size());
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (plateaus.size() >= 4)
-    for (long c = 0; c < static_cast<long>(plateaus.size()); ++c)
-    {
-      plateau_seeds[c] =
-          plateauSeeds(*map_, found.leaves, plateaus[c], readings, loose_gate, 4.0 * cell_xy_, 4.0 * cell_theta_,
-                       plateaus[c].members.size() >= kLargePlateau ? kSeedsPerPlateau : 1);
-    }
-    std::vector<LeafCluster> maxima;
-    for (std::size_t c = 0; c < plateaus.size(); ++c)
-    {
-      for (const Pose2& seed : plateau_seeds[c])
-      {
-        maxima.push_back(plateaus[c]);
-        maxima.back().centroid = seed;
-      }
-    }
-    result.times.verification += secondsSince(stage);
-
-    const std::size_t first = seeds.size();
-    seeds.resize(first + maxima.size());
-    std::vector<std::vector<bool>> hypotheses(maxima.size());
-    std::vector<char> plausible(maxima.size(), 0);
-    std::vector<Pose2> starts(maxima.size());
-    stage = std::chrono::steady_clock::now();
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (maxima.size() >= 4)
-    for (long c = 0; c < static_cast<long>(maxima.size()); ++c)
-    {
-      hypotheses[c] = hypothesisOf(found.leaves[maxima[c].representative], readings.size());
-      starts[c] = maxima[c].centroid;
-      seeds[first + c] = verifiedCandidate(*map_, starts[c], readings, options_.agreement_tolerance);
-      plausible[c] = evaluatePose(*map_, starts[c], readings, loose_gate).inliers >= level - 2;
-    }
-    result.times.verification += secondsSince(stage);
-
-    stage = std::chrono::steady_clock::now();
-    RefinementSettings level_settings = settings;
-    level_settings.escape_min_inliers = std::max(3, level - 1);
-    level_settings.target_inliers = level;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (maxima.size() >= 4)
-    for (long c = 0; c < static_cast<long>(maxima.size()); ++c)
-    {
-      if (plausible[c])
-      {
-        seeds[first + c] = refineSeed(*map_, starts[c], readings, hypotheses[c], level_settings);
-      }
-    }
-    // No seed explains as many readings as this level promises: a seed may sit behind an
-    // occlusion edge. Retry the first ones with a local lattice search and from other leaves.
-    const bool reached =
-        std::any_of(seeds.begin(), seeds.end(), [&](const Candidate& s) { return s.inliers >= level; });
-    if (!reached)
-    {
-      const long retried = std::min<long>(static_cast<long>(maxima.size()), kRetriedSeeds);
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (retried >= 4)
-      for (long c = 0; c < retried; ++c)
-      {
-        Candidate& seed = seeds[first + c];
-        const LeafCluster& cluster = maxima[c];
-        if (c < kLocallySearchedSeeds)
-        {
-          RefinementSettings local = level_settings;
-          local.local_search_cells = 2;
-          local.local_search_step = 0.5 * cell_xy_;
-          local.local_search_angle_step = 0.5 * cell_theta_;
-          Candidate retry = refineSeed(*map_, cluster.centroid, readings, hypotheses[c], local);
-          if (betterCandidate(retry, seed))
-          {
-            seed = std::move(retry);
-          }
-        }
-        const std::size_t n = cluster.members.size();
-        const Pose2 others[3] = { found.leaves[cluster.representative].box.centre(),
-                                  found.leaves[cluster.members[n / 3]].box.centre(),
-                                  found.leaves[cluster.members[(2 * n) / 3]].box.centre() };
-        for (const Pose2& other : others)
-        {
-          if (seed.inliers >= level)
-          {
-            break;
-          }
-          Candidate retry = refineSeed(*map_, other, readings, hypotheses[c], level_settings);
-          if (betterCandidate(retry, seed))
-          {
-            seed = std::move(retry);
-          }
-        }
-      }
-    }
-    result.times.polish += secondsSince(stage);
-    for (std::size_t c = 0; c < maxima.size(); ++c)
-    {
-      seeds[first + c].support = static_cast<double>(maxima[c].size);
-    }
-
-    if (found.truncated)
-    {
-      used_level = level;
-      break;
-    }
-    if (automatic)
-    {
-      if (std::any_of(seeds.begin(), seeds.end(), [&](const Candidate& s) { return s.inliers >= level; }))
-      {
-        used_level = level;
-        break;
-      }
-    }
-    else if (level > lowest)
-    {
-      // Fixed k': once max_candidates distinct poses explain at least `level` readings, the
-      // lower levels' seeds (which promise fewer) cannot enter the ranked list.
-      std::vector<Candidate> strong;
-      std::copy_if(seeds.begin(), seeds.end(), std::back_inserter(strong),
-                   [&](const Candidate& s) { return s.inliers >= level; });
-      if (static_cast<int>(rankAndDeduplicate(std::move(strong), options_.uniqueness_distance,
-                                              options_.uniqueness_angle, options_.max_candidates)
-                               .size()) >= options_.max_candidates)
-      {
-        break;
-      }
-    }
-  }
-  result.min_inliers_used = automatic ? used_level : options_.min_inliers;
-  std::vector<Candidate> kept;
-  std::copy_if(std::make_move_iterator(seeds.begin()), std::make_move_iterator(seeds.end()), std::back_inserter(kept),
-               [&](const Candidate& s) { return s.inliers >= result.min_inliers_used; });
-  result.candidates = rankAndDeduplicate(std::move(kept), options_.uniqueness_distance, options_.uniqueness_angle,
-                                         options_.max_candidates);
+  const SeedScale scale{ cell_xy_, cell_theta_ };
+  // A plateau's leaves are ranked with the shared search's loose agreement band.
+  LeafSeeds seeds(*map_, search, readings, cell_xy_, cell_theta_, seedGate(readings, options_, scale), threads,
+                  result.times);
+  SeedSearchOutcome found = robustSearch(seeds, *map_, readings, options_, scale, result.times);
+  result.min_inliers_used = found.min_inliers_used;
+  result.candidates = std::move(found.candidates);
 }
 
 AdaptiveEngine::AdaptiveEngine(std::shared_ptr<const MapRayCaster> map, const LocalizerOptions& options)

@@ -1,8 +1,10 @@
 // The voxel engine's candidate stages: component centres (paper, baseline) and the robust
-// search (maximal hypotheses and count peaks as seeds, polish, automatic or fixed k').
+// search's seeds (maximal hypotheses and count peaks) for the shared robust search (seed_search.h).
 #include "fdml_localization/core/localization/voxel/voxel_engine.h"
 
+#include "fdml_localization/core/localization/ranking.h"
 #include "fdml_localization/core/localization/robust_search.h"
+#include "fdml_localization/core/localization/seed_search.h"
 #include "fdml_localization/core/localization/components.h"
 #include "fdml_localization/core/localization/hypothesis_seeds.h"
 #include "fdml_localization/core/util/stopwatch.h"
@@ -20,151 +22,58 @@ namespace core
 {
 namespace
 {
-/// Seeds retried from other voxels of their plateau when no seed reaches a level ...
-constexpr std::size_t kRetriedSeeds = 32;
-/// ... of which this many first get a local lattice search around their centroid.
-constexpr std::size_t kLocallySearchedSeeds = 8;
-
-/// What the robust search needs to refine a seed.
-struct SearchContext
+/// The voxel engine's seeds, level by level: every locally maximal set of readings of the raw
+/// preimages (hypothesis_seeds.h) and, because the raw test can miss the truth's voxel next to a
+/// discontinuity of h, the count peaks of the dilated preimages.
+class VoxelSeeds : public SeedSource
 {
-  const MapRayCaster& map;
-  const GridSpec& spec;
-  const std::vector<Reading>& readings;
-  RefinementSettings settings;
-  double loose_gate = 0.0;  ///< agreement band of the rough count at a seed's centroid [m]
-  int threads = 1;
-};
-
-/// The seeds of the robust search and what became of them, in the order they were found.
-struct SeedPool
-{
-  std::vector<VoxelCluster> plateaus;  ///< peak_count = readings the seed's voxels explain
-  std::vector<std::vector<bool>> hypotheses;
-  std::vector<Candidate> candidates;
-  std::vector<int> rough;  ///< readings agreeing within the loose gate at the centroid
-  std::vector<char> refined;
-  std::vector<char> retried;
-
-  void add(VoxelCluster plateau, std::vector<bool> hypothesis)
+public:
+  VoxelSeeds(const VoxelEngine& engine, int lowest, int k, StageTimes& times) : engine_(engine), times_(times)
   {
-    plateaus.push_back(std::move(plateau));
-    hypotheses.push_back(std::move(hypothesis));
+    const auto stage = std::chrono::steady_clock::now();
+    buckets_ = voxelsByCount(engine.lastCount(), lowest, k);
+    raw_buckets_ = voxelsByCount(engine.lastRawCount(), lowest, k);
+    times_.components += secondsSince(stage);
   }
 
-  /// The most inliers of any candidate so far.
-  int best() const
+  std::vector<SearchSeed> seedsAt(int level) override
   {
-    return std::accumulate(candidates.begin(), candidates.end(), 0,
-                           [](int m, const Candidate& c) { return std::max(m, c.inliers); });
-  }
-
-  /// The largest net consensus (inliers - contradicted readings) of any candidate so far.
-  int bestNet() const
-  {
-    return std::accumulate(candidates.begin(), candidates.end(), 0,
-                           [](int m, const Candidate& c) { return std::max(m, netConsensus(c)); });
-  }
-
-  /// Verifies the seeds added since the last call at their centroids.
-  void evaluateNew(const SearchContext& ctx)
-  {
-    const long first = static_cast<long>(candidates.size());
-    const long n = static_cast<long>(plateaus.size());
-    candidates.resize(n);
-    rough.resize(n, 0);
-    refined.resize(n, 0);
-    retried.resize(n, 0);
-#pragma omp parallel for schedule(dynamic, 1) num_threads(ctx.threads) if (n - first >= 4)
-    for (long c = first; c < n; ++c)
+    const auto stage = std::chrono::steady_clock::now();
+    const GridSpec& spec = engine_.grid();
+    std::vector<SearchSeed> seeds;
+    for (HypothesisSeed& h : maximalHypotheses(spec, engine_.lastRawPreimages(), engine_.lastRawCount(), level,
+                                               raw_buckets_[level], engine_.threads()))
     {
-      const Pose2& centroid = plateaus[c].centroid;
-      candidates[c] = verifiedCandidate(ctx.map, centroid, ctx.readings, ctx.settings.agreement_tolerance);
-      rough[c] = evaluatePose(ctx.map, centroid, ctx.readings, ctx.loose_gate).inliers;
+      seeds.push_back(seedOf(h.plateau, std::move(h.hypothesis)));
     }
-  }
-
-  /// Refines, once, every seed that could reach @p level: as many readings in its plateau and
-  /// at least level - 2 of them roughly agreeing at its centroid.
-  void refineFor(int level, const SearchContext& ctx)
-  {
-    const RefinementSettings with = levelSettings(level, ctx);
-    const long n = static_cast<long>(plateaus.size());
-#pragma omp parallel for schedule(dynamic, 1) num_threads(ctx.threads) if (n >= 4)
-    for (long c = 0; c < n; ++c)
+    for (VoxelCluster& c : regionalMaxima(spec, engine_.lastCount(), level, buckets_[level]))
     {
-      if (!refined[c] && plateaus[c].peak_count >= level && rough[c] >= level - 2)
-      {
-        refined[c] = 1;
-        keepBetter(c, refineSeed(ctx.map, plateaus[c].centroid, ctx.readings, hypotheses[c], with));
-      }
+      seeds.push_back(seedOf(c, engine_.membership(c.representative, engine_.lastPreimages())));
     }
-  }
-
-  /**
-   * @brief Second chances for the seeds that promise @p level but fell short: the optimum may
-   *        lie across an occlusion edge from the centroid, where no descent reaches it, or far
-   *        from it on a large plateau. The most promising (most readings, then most rough
-   *        agreement) get a local lattice search and restarts from other plateau voxels; a
-   *        fixed number, so the result does not depend on thread timing.
-   */
-  void retryFor(int level, const SearchContext& ctx)
-  {
-    std::vector<long> order;
-    for (long c = 0; c < static_cast<long>(plateaus.size()); ++c)
-    {
-      if (!retried[c] && plateaus[c].peak_count >= level && netConsensus(candidates[c]) < level)
-      {
-        order.push_back(c);
-      }
-    }
-    std::stable_sort(order.begin(), order.end(), [&](long a, long b) {
-      return plateaus[a].peak_count != plateaus[b].peak_count ? plateaus[a].peak_count > plateaus[b].peak_count :
-                                                                rough[a] > rough[b];
-    });
-    order.resize(std::min(order.size(), kRetriedSeeds));
-    const RefinementSettings with = levelSettings(level, ctx);
-    RefinementSettings search = with;
-    search.local_search_cells = 2;
-    search.local_search_step = 0.5 * ctx.spec.cell;
-    search.local_search_angle_step = 0.5 * ctx.spec.thetaStep();
-#pragma omp parallel for schedule(dynamic, 1) num_threads(ctx.threads) if (order.size() >= 2)
-    for (std::size_t j = 0; j < order.size(); ++j)
-    {
-      const long c = order[j];
-      retried[c] = 1;
-      const VoxelCluster& plateau = plateaus[c];
-      if (j < kLocallySearchedSeeds)
-      {
-        keepBetter(c, refineSeed(ctx.map, plateau.centroid, ctx.readings, hypotheses[c], search));
-      }
-      const std::size_t n = plateau.voxels.size();
-      for (std::size_t v : { plateau.representative, plateau.voxels[n / 3], plateau.voxels[(2 * n) / 3] })
-      {
-        if (netConsensus(candidates[c]) < level)
-        {
-          keepBetter(c, refineSeed(ctx.map, ctx.spec.centre(v), ctx.readings, hypotheses[c], with));
-        }
-      }
-    }
+    times_.components += secondsSince(stage);
+    return seeds;
   }
 
 private:
-  static RefinementSettings levelSettings(int level, const SearchContext& ctx)
+  SearchSeed seedOf(const VoxelCluster& plateau, std::vector<bool> hypothesis) const
   {
-    RefinementSettings with = ctx.settings;
-    with.escape_min_inliers = std::max(3, level - 1);
-    with.target_inliers = level;
-    return with;
+    SearchSeed seed;
+    seed.start = plateau.centroid;
+    seed.hypothesis = std::move(hypothesis);
+    seed.promised = plateau.peak_count;
+    seed.region = plateau.representative;
+    const std::size_t n = plateau.voxels.size();
+    for (std::size_t v : { plateau.representative, plateau.voxels[n / 3], plateau.voxels[(2 * n) / 3] })
+    {
+      seed.retry_starts.push_back(engine_.grid().centre(v));
+    }
+    return seed;
   }
 
-  void keepBetter(long c, Candidate candidate)
-  {
-    if (betterCandidate(candidate, candidates[c]))
-    {
-      candidates[c] = std::move(candidate);
-    }
-  }
+  const VoxelEngine& engine_;
+  StageTimes& times_;
+  std::vector<std::vector<std::size_t>> buckets_;
+  std::vector<std::vector<std::size_t>> raw_buckets_;
 };
 }  // namespace
 
@@ -199,123 +108,15 @@ void VoxelEngine::localizeComponentCentres(const std::vector<Reading>& readings,
 void VoxelEngine::localizeRobust(const std::vector<Reading>& readings, Result& result)
 {
   const int k = static_cast<int>(readings.size());
-  const bool automatic = options_.min_inliers <= 0;
-  const int lowest = automatic ? 3 : options_.min_inliers;
-
-  std::vector<double> finite;
-  for (const Reading& r : readings)
-  {
-    if (std::isfinite(r.range))
-    {
-      finite.push_back(r.range);
-    }
-  }
-  double typical_range = 1.0;
-  if (!finite.empty())
-  {
-    std::nth_element(finite.begin(), finite.begin() + finite.size() / 2, finite.end());
-    typical_range = finite[finite.size() / 2];
-  }
-  SearchContext ctx{ *map_, spec_, readings, RefinementSettings(), 0.0, threads() };
-  ctx.settings.agreement_tolerance = options_.agreement_tolerance;
-  ctx.settings.robust_scale =
-      std::max(options_.agreement_tolerance, 0.5 * spec_.cell + 0.5 * spec_.thetaStep() * typical_range);
-  ctx.settings.noise_sigma = std::max(options_.range_tolerance / std::sqrt(3.0), 1e-4);
-  ctx.settings.seed_position_error = 1.5 * spec_.cell;
-  ctx.settings.seed_angle_error = spec_.thetaStep();
-  ctx.loose_gate = 3.0 * ctx.settings.robust_scale;
-
-  // Seeds, level by level: every locally maximal set of readings of the raw preimages
-  // (hypothesis_seeds.h) and, because the raw test can miss the truth's voxel next to a
-  // discontinuity of h, the count peaks of the dilated preimages.
-  auto stage = std::chrono::steady_clock::now();
-  const std::vector<std::vector<std::size_t>> buckets = voxelsByCount(count_, lowest, k);
-  const std::vector<std::vector<std::size_t>> raw_buckets = voxelsByCount(raw_count_, lowest, k);
-  result.times.components += secondsSince(stage);
-
-  SeedPool pool;
-  int used_level = lowest;
-  bool reached = false;
-  for (int level = k; level >= lowest && !reached; --level)
-  {
-    stage = std::chrono::steady_clock::now();
-    for (HypothesisSeed& h : maximalHypotheses(spec_, raw_sets_, raw_count_, level, raw_buckets[level], threads()))
-    {
-      pool.add(std::move(h.plateau), std::move(h.hypothesis));
-    }
-    for (VoxelCluster& c : regionalMaxima(spec_, count_, level, buckets[level]))
-    {
-      std::vector<bool> hypothesis = membership(c.representative, sets_);
-      pool.add(std::move(c), std::move(hypothesis));
-    }
-    result.times.components += secondsSince(stage);
-    stage = std::chrono::steady_clock::now();
-    pool.evaluateNew(ctx);
-    result.times.verification += secondsSince(stage);
-    stage = std::chrono::steady_clock::now();
-    pool.refineFor(level, ctx);
-    result.times.polish += secondsSince(stage);
-
-    if (automatic)
-    {
-      // Maximum consensus: the first level some seed reaches, net of the readings its pose
-      // contradicts (a pose where a reading passes through a wall must explain one more).
-      reached = pool.bestNet() >= level;
-      used_level = reached ? level : used_level;
-    }
-    else if (level > lowest)
-    {
-      // Fixed k': once max_candidates distinct poses explain at least `level` readings net, the
-      // lower levels' seeds (which promise fewer) cannot enter the ranked list.
-      std::vector<Candidate> strong;
-      std::copy_if(pool.candidates.begin(), pool.candidates.end(), std::back_inserter(strong),
-                   [&](const Candidate& c) { return netConsensus(c) >= level; });
-      const std::vector<Candidate> ranked = rankAndDeduplicate(std::move(strong), options_.uniqueness_distance,
-                                                               options_.uniqueness_angle, options_.max_candidates);
-      reached = static_cast<int>(ranked.size()) >= options_.max_candidates;
-    }
-  }
-  // Second chances, one level above what was reached (automatic: a larger consensus may have
-  // been missed) or at k' when nothing reached it.
-  stage = std::chrono::steady_clock::now();
-  if (automatic)
-  {
-    for (int target = reached ? used_level + 1 : lowest; target <= k; target = used_level + 1)
-    {
-      pool.retryFor(target, ctx);
-      if (pool.bestNet() < target)
-      {
-        break;
-      }
-      used_level = pool.bestNet();
-    }
-  }
-  else if (pool.best() < lowest)
-  {
-    pool.retryFor(lowest, ctx);
-  }
-  result.times.polish += secondsSince(stage);
-  result.min_inliers_used = automatic ? used_level : options_.min_inliers;
-
-  std::vector<Candidate> kept;
-  for (std::size_t c = 0; c < pool.candidates.size(); ++c)
-  {
-    if (pool.candidates[c].inliers >= result.min_inliers_used)
-    {
-      // The seed voxel rides in support until the duplicates are gone.
-      pool.candidates[c].support = static_cast<double>(pool.plateaus[c].representative);
-      kept.push_back(std::move(pool.candidates[c]));
-    }
-  }
-  result.candidates = rankAndDeduplicate(std::move(kept), options_.uniqueness_distance, options_.uniqueness_angle,
-                                         options_.max_candidates);
-  stage = std::chrono::steady_clock::now();
-  std::vector<std::size_t> voxels;
-  for (const Candidate& c : result.candidates)
-  {
-    voxels.push_back(static_cast<std::size_t>(c.support));
-  }
-  const std::vector<std::size_t> sizes = componentSizes(spec_, count_, result.min_inliers_used, voxels);
+  const int lowest = options_.min_inliers > 0 ? options_.min_inliers : 3;
+  VoxelSeeds seeds(*this, lowest, k, result.times);
+  SeedSearchOutcome found =
+      robustSearch(seeds, *map_, readings, options_, SeedScale{ spec_.cell, spec_.thetaStep() }, result.times);
+  result.min_inliers_used = found.min_inliers_used;
+  result.candidates = std::move(found.candidates);
+  // Support: the size of the component of each candidate's seed voxel at k'.
+  const auto stage = std::chrono::steady_clock::now();
+  const std::vector<std::size_t> sizes = componentSizes(spec_, count_, result.min_inliers_used, found.regions);
   for (std::size_t i = 0; i < sizes.size(); ++i)
   {
     result.candidates[i].support = static_cast<double>(sizes[i]);

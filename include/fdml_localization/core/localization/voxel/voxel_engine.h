@@ -92,13 +92,24 @@ public:
   {
     return sets_;
   }
+  /// The same before dilation (seeding only).
+  const std::vector<std::uint8_t>& lastRawCount() const
+  {
+    return raw_count_;
+  }
+  const std::vector<VoxelSet>& lastRawPreimages() const
+  {
+    return raw_sets_;
+  }
+  /// OpenMP threads of a call (options.threads, or all cores).
+  int threads() const;
+  /// Per set: whether it holds @p voxel.
+  std::vector<bool> membership(std::size_t voxel, const std::vector<VoxelSet>& sets) const;
 
 private:
-  int threads() const;
   void fillPreimageSlice(const Reading& reading, int it, VoxelSet& set) const;
   void localizeRobust(const std::vector<Reading>& readings, Result& result);
   void localizeComponentCentres(const std::vector<Reading>& readings, int min_inliers, Result& result);
-  std::vector<bool> membership(std::size_t voxel, const std::vector<VoxelSet>& sets) const;
 
   std::shared_ptr<const MapRayCaster> map_;
   LocalizerOptions options_;

@@ -1,0 +1,53 @@
+/**
+ * @file ranking.h
+ * @brief The one ranking of candidate poses and the one ambiguity rule, used by both engines,
+ *        the node, fdml_localize, fdml_bench and the demo.
+ *
+ * Unknown obstacles only shorten readings, so a reading the map contradicts at a pose (measured
+ * longer than the map allows, or no return where the map has a wall in range) counts against
+ * that pose: candidates rank by net consensus (inliers - contradicted), then fewer contradicted
+ * readings, then lower RMS residual. Without contradicted readings this is "most inliers, then
+ * lowest RMS" (the paper's order).
+ */
+#pragma once
+
+#include "fdml_localization/core/localization/localizer.h"
+
+#include <vector>
+
+namespace fdml_localization
+{
+namespace core
+{
+/// Net consensus of a candidate: inliers minus the readings the map contradicts at its pose.
+inline int netConsensus(const Candidate& c)
+{
+  return c.inliers - c.contradicted;
+}
+
+/**
+ * @brief The ranking order on raw figures (so that evaluations and candidates share it): the
+ *        larger net consensus first, then fewer contradicted readings, then lower RMS [m].
+ */
+bool rankedBefore(int inliers_a, int contradicted_a, double rms_a, int inliers_b, int contradicted_b, double rms_b);
+
+/// The ranking order on candidates (see rankedBefore()).
+bool betterCandidate(const Candidate& a, const Candidate& b);
+
+/**
+ * @brief Sorts best first and drops every candidate closer than (@p distance [m], @p angle
+ *        [rad]) to a better one kept before it; keeps at most @p max_candidates.
+ */
+std::vector<Candidate> rankAndDeduplicate(std::vector<Candidate> candidates, double distance, double angle,
+                                          int max_candidates);
+
+/**
+ * @brief The one ambiguity rule: a result's best candidate is unambiguous when it is the only
+ *        candidate, or when its net consensus is strictly larger than the second's. Candidates
+ *        tied on net consensus are different places that explain the readings equally well
+ *        (a symmetric room): no single pose is claimed.
+ */
+bool isUnambiguous(const Result& result);
+
+}  // namespace core
+}  // namespace fdml_localization

@@ -1,0 +1,57 @@
+#include "fdml_localization/core/localization/ranking.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace fdml_localization
+{
+namespace core
+{
+bool rankedBefore(int inliers_a, int contradicted_a, double rms_a, int inliers_b, int contradicted_b, double rms_b)
+{
+  const int net_a = inliers_a - contradicted_a;
+  const int net_b = inliers_b - contradicted_b;
+  if (net_a != net_b)
+  {
+    return net_a > net_b;
+  }
+  return contradicted_a != contradicted_b ? contradicted_a < contradicted_b : rms_a < rms_b;
+}
+
+bool betterCandidate(const Candidate& a, const Candidate& b)
+{
+  return rankedBefore(a.inliers, a.contradicted, a.rms_residual, b.inliers, b.contradicted, b.rms_residual);
+}
+
+std::vector<Candidate> rankAndDeduplicate(std::vector<Candidate> candidates, double distance, double angle,
+                                          int max_candidates)
+{
+  std::stable_sort(candidates.begin(), candidates.end(), betterCandidate);
+  std::vector<Candidate> kept;
+  for (Candidate& c : candidates)
+  {
+    if (static_cast<int>(kept.size()) >= max_candidates)
+    {
+      break;
+    }
+    const bool duplicate = std::any_of(kept.begin(), kept.end(), [&](const Candidate& k) {
+      return std::hypot(c.pose.x - k.pose.x, c.pose.y - k.pose.y) < distance &&
+             std::abs(angleDiff(c.pose.theta, k.pose.theta)) < angle;
+    });
+    if (!duplicate)
+    {
+      kept.push_back(std::move(c));
+    }
+  }
+  return kept;
+}
+
+bool isUnambiguous(const Result& result)
+{
+  const std::vector<Candidate>& c = result.candidates;
+  return c.size() == 1 || (c.size() > 1 && netConsensus(c[0]) > netConsensus(c[1]));
+}
+
+}  // namespace core
+}  // namespace fdml_localization

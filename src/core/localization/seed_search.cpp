@@ -1,0 +1,312 @@
+#include "fdml_localization/core/localization/seed_search.h"
+
+#include "fdml_localization/core/localization/ranking.h"
+#include "fdml_localization/core/util/stopwatch.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <iterator>
+#include <numeric>
+
+namespace fdml_localization
+{
+namespace core
+{
+namespace
+{
+/// Seeds retried from other poses of their region when no seed reaches a level ...
+constexpr std::size_t kRetriedSeeds = 32;
+/// ... of which this many first get a local lattice search around their start.
+constexpr std::size_t kLocallySearchedSeeds = 8;
+
+/// What refining a seed needs.
+struct SearchContext
+{
+  const MapRayCaster& map;
+  const std::vector<Reading>& readings;
+  SeedScale scale;
+  RefinementSettings settings;
+  double loose_gate = 0.0;  ///< agreement band of the rough count at a seed's start [m]
+  int threads = 1;
+};
+
+double medianFiniteRange(const std::vector<Reading>& readings)
+{
+  std::vector<double> finite;
+  for (const Reading& r : readings)
+  {
+    if (std::isfinite(r.range))
+    {
+      finite.push_back(r.range);
+    }
+  }
+  if (finite.empty())
+  {
+    return 1.0;
+  }
+  std::nth_element(finite.begin(), finite.begin() + finite.size() / 2, finite.end());
+  return finite[finite.size() / 2];
+}
+
+/// The seeds and what became of them, in the order they were supplied.
+class SeedPool
+{
+public:
+  explicit SeedPool(const SearchContext& ctx) : ctx_(ctx)
+  {}
+
+  /// Adds @p seeds and verifies them at their starts.
+  void add(std::vector<SearchSeed> seeds)
+  {
+    const long first = static_cast<long>(seeds_.size());
+    std::move(seeds.begin(), seeds.end(), std::back_inserter(seeds_));
+    const long n = static_cast<long>(seeds_.size());
+    candidates_.resize(n);
+    rough_.resize(n, 0);
+    refined_.resize(n, 0);
+    retried_.resize(n, 0);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(ctx_.threads) if (n - first >= 4)
+    for (long c = first; c < n; ++c)
+    {
+      const Pose2& start = seeds_[c].start;
+      candidates_[c] = verifiedCandidate(ctx_.map, start, ctx_.readings, ctx_.settings.agreement_tolerance);
+      rough_[c] = evaluatePose(ctx_.map, start, ctx_.readings, ctx_.loose_gate).inliers;
+    }
+  }
+
+  /// The most inliers of any candidate so far.
+  int best() const
+  {
+    return std::accumulate(candidates_.begin(), candidates_.end(), 0,
+                           [](int m, const Candidate& c) { return std::max(m, c.inliers); });
+  }
+
+  /// The largest net consensus (inliers - contradicted readings) of any candidate so far.
+  int bestNet() const
+  {
+    return std::accumulate(candidates_.begin(), candidates_.end(), 0,
+                           [](int m, const Candidate& c) { return std::max(m, netConsensus(c)); });
+  }
+
+  /// Distinct candidates reaching @p level net, ranked.
+  std::size_t distinctReaching(int level, const LocalizerOptions& options) const
+  {
+    std::vector<Candidate> strong;
+    std::copy_if(candidates_.begin(), candidates_.end(), std::back_inserter(strong),
+                 [&](const Candidate& c) { return netConsensus(c) >= level; });
+    return rankAndDeduplicate(std::move(strong), options.uniqueness_distance, options.uniqueness_angle,
+                              options.max_candidates)
+        .size();
+  }
+
+  /// Refines, once, every seed that could reach @p level: its region explains as many readings
+  /// and at least level - 2 of them roughly agree at its start.
+  void refineFor(int level)
+  {
+    const RefinementSettings with = levelSettings(level);
+    const long n = static_cast<long>(seeds_.size());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(ctx_.threads) if (n >= 4)
+    for (long c = 0; c < n; ++c)
+    {
+      if (!refined_[c] && seeds_[c].promised >= level && rough_[c] >= level - 2)
+      {
+        refined_[c] = 1;
+        keepBetter(c, refineSeed(ctx_.map, seeds_[c].start, ctx_.readings, seeds_[c].hypothesis, with));
+      }
+    }
+  }
+
+  /**
+   * @brief Second chances for the seeds that promise @p level but fell short: the optimum may
+   *        lie across an occlusion edge from the start, where no descent reaches it, or far from
+   *        it in a large region. The most promising (most readings, then most rough agreement)
+   *        get a local lattice search and restarts from other poses of their region; a fixed
+   *        number, so the result does not depend on thread timing.
+   */
+  void retryFor(int level)
+  {
+    const std::vector<long> order = retryOrder(level);
+    const RefinementSettings with = levelSettings(level);
+    RefinementSettings search = with;
+    search.local_search_cells = 2;
+    search.local_search_step = 0.5 * ctx_.scale.cell_xy;
+    search.local_search_angle_step = 0.5 * ctx_.scale.cell_theta;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(ctx_.threads) if (order.size() >= 2)
+    for (std::size_t j = 0; j < order.size(); ++j)
+    {
+      const long c = order[j];
+      retried_[c] = 1;
+      const SearchSeed& seed = seeds_[c];
+      if (j < kLocallySearchedSeeds)
+      {
+        keepBetter(c, refineSeed(ctx_.map, seed.start, ctx_.readings, seed.hypothesis, search));
+      }
+      for (const Pose2& start : seed.retry_starts)
+      {
+        if (netConsensus(candidates_[c]) < level)
+        {
+          keepBetter(c, refineSeed(ctx_.map, start, ctx_.readings, seed.hypothesis, with));
+        }
+      }
+    }
+  }
+
+  /// The candidates explaining at least @p level readings, ranked, with their seeds' regions.
+  SeedSearchOutcome ranked(int level, const LocalizerOptions& options)
+  {
+    std::vector<Candidate> kept;
+    for (std::size_t c = 0; c < candidates_.size(); ++c)
+    {
+      if (candidates_[c].inliers >= level)
+      {
+        // The seed's index rides in support until the duplicates are gone.
+        candidates_[c].support = static_cast<double>(c);
+        kept.push_back(std::move(candidates_[c]));
+      }
+    }
+    SeedSearchOutcome outcome;
+    outcome.min_inliers_used = level;
+    outcome.candidates = rankAndDeduplicate(std::move(kept), options.uniqueness_distance, options.uniqueness_angle,
+                                            options.max_candidates);
+    for (Candidate& candidate : outcome.candidates)
+    {
+      const SearchSeed& seed = seeds_[static_cast<std::size_t>(candidate.support)];
+      outcome.regions.push_back(seed.region);
+      candidate.support = seed.support;
+    }
+    return outcome;
+  }
+
+private:
+  std::vector<long> retryOrder(int level) const
+  {
+    std::vector<long> order;
+    for (long c = 0; c < static_cast<long>(seeds_.size()); ++c)
+    {
+      if (!retried_[c] && seeds_[c].promised >= level && netConsensus(candidates_[c]) < level)
+      {
+        order.push_back(c);
+      }
+    }
+    std::stable_sort(order.begin(), order.end(), [&](long a, long b) {
+      return seeds_[a].promised != seeds_[b].promised ? seeds_[a].promised > seeds_[b].promised : rough_[a] > rough_[b];
+    });
+    order.resize(std::min(order.size(), kRetriedSeeds));
+    return order;
+  }
+
+  RefinementSettings levelSettings(int level) const
+  {
+    RefinementSettings with = ctx_.settings;
+    with.escape_min_inliers = std::max(3, level - 1);
+    with.target_inliers = level;
+    return with;
+  }
+
+  void keepBetter(long c, Candidate candidate)
+  {
+    if (betterCandidate(candidate, candidates_[c]))
+    {
+      candidates_[c] = std::move(candidate);
+    }
+  }
+
+  const SearchContext& ctx_;
+  std::vector<SearchSeed> seeds_;
+  std::vector<Candidate> candidates_;
+  std::vector<int> rough_;  ///< readings agreeing within the loose gate at the start
+  std::vector<char> refined_;
+  std::vector<char> retried_;
+};
+
+SearchContext makeContext(const MapRayCaster& map, const std::vector<Reading>& readings,
+                          const LocalizerOptions& options, const SeedScale& scale)
+{
+  SearchContext ctx{ map, readings, scale, RefinementSettings(), 0.0, 1 };
+  ctx.threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+  ctx.settings.agreement_tolerance = options.agreement_tolerance;
+  ctx.settings.robust_scale = seedGate(readings, options, scale) / 3.0;
+  ctx.settings.noise_sigma = std::max(options.range_tolerance / std::sqrt(3.0), 1e-4);
+  ctx.settings.seed_position_error = 1.5 * scale.cell_xy;
+  ctx.settings.seed_angle_error = scale.cell_theta;
+  // Seeds where fewer than (level - 2) readings agree even this loosely are not polished.
+  ctx.loose_gate = seedGate(readings, options, scale);
+  return ctx;
+}
+
+/// Second chances after the levels: returns the k' finally used.
+int secondChances(SeedPool& pool, bool automatic, bool reached, int used_level, int lowest, int k)
+{
+  if (!automatic)
+  {
+    if (pool.best() < lowest)
+    {
+      pool.retryFor(lowest);
+    }
+    return lowest;
+  }
+  // One level above what was reached (a larger consensus may have been missed), or at the
+  // lowest level when nothing reached it.
+  for (int target = reached ? used_level + 1 : lowest; target <= k; target = used_level + 1)
+  {
+    pool.retryFor(target);
+    if (pool.bestNet() < target)
+    {
+      break;
+    }
+    used_level = pool.bestNet();
+  }
+  return used_level;
+}
+}  // namespace
+
+double seedGate(const std::vector<Reading>& readings, const LocalizerOptions& options, const SeedScale& scale)
+{
+  return 3.0 * std::max(options.agreement_tolerance,
+                        0.5 * scale.cell_xy + 0.5 * scale.cell_theta * medianFiniteRange(readings));
+}
+
+SeedSearchOutcome robustSearch(SeedSource& source, const MapRayCaster& map, const std::vector<Reading>& readings,
+                               const LocalizerOptions& options, const SeedScale& scale, StageTimes& times)
+{
+  const int k = static_cast<int>(readings.size());
+  const bool automatic = options.min_inliers <= 0;
+  const int lowest = automatic ? 3 : options.min_inliers;
+  const SearchContext ctx = makeContext(map, readings, options, scale);
+  SeedPool pool(ctx);
+  int used_level = lowest;
+  bool reached = false;
+  for (int level = k; level >= lowest && !reached && !source.exhausted(); --level)
+  {
+    std::vector<SearchSeed> seeds = source.seedsAt(level);
+    auto stage = std::chrono::steady_clock::now();
+    pool.add(std::move(seeds));
+    times.verification += secondsSince(stage);
+    stage = std::chrono::steady_clock::now();
+    pool.refineFor(level);
+    times.polish += secondsSince(stage);
+    if (automatic)
+    {
+      // Maximum consensus: the first level some seed reaches, net of the readings its pose
+      // contradicts (a pose where a reading passes through a wall must explain one more).
+      reached = pool.bestNet() >= level || source.exhausted();
+      used_level = reached ? level : used_level;
+    }
+    else if (level > lowest)
+    {
+      // Fixed k': once max_candidates distinct poses reach `level` net, the lower levels' seeds
+      // (which promise fewer) cannot enter the ranked list.
+      reached = static_cast<int>(pool.distinctReaching(level, options)) >= options.max_candidates;
+    }
+  }
+  const auto stage = std::chrono::steady_clock::now();
+  const int level = secondChances(pool, automatic, reached && pool.bestNet() >= used_level, used_level, lowest, k);
+  times.polish += secondsSince(stage);
+  return pool.ranked(automatic ? level : options.min_inliers, options);
+}
+
+}  // namespace core
+}  // namespace fdml_localization

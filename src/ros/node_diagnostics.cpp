@@ -1,0 +1,71 @@
+#include "fdml_localization/ros/node_diagnostics.h"
+
+#include <string>
+
+namespace fdml_localization
+{
+namespace
+{
+void summarize(const NodeState& state, diagnostic_updater::DiagnosticStatusWrapper& status)
+{
+  using diagnostic_msgs::DiagnosticStatus;
+  const NodeStatistics& stats = state.stats;
+  if (!state.have_map)
+  {
+    status.summary(stats.maps_rejected > 0 ? DiagnosticStatus::ERROR : DiagnosticStatus::WARN,
+                   stats.maps_rejected > 0 ? "no usable map: " + stats.last_map_error : std::string("no map yet"));
+  }
+  else if (stats.last_candidates < 0)
+  {
+    status.summary(DiagnosticStatus::OK, "no batch solved yet (" + state.activity + ")");
+  }
+  else if (!stats.last_error.empty() && stats.last_candidates == 0)
+  {
+    status.summary(DiagnosticStatus::ERROR, stats.last_error);
+  }
+  else if (stats.last_candidates == 0)
+  {
+    status.summary(DiagnosticStatus::WARN, "no pose explains the last batch");
+  }
+  else if (!stats.last_unambiguous)
+  {
+    status.summary(DiagnosticStatus::WARN,
+                   "ambiguous: " + std::to_string(stats.last_candidates) + " candidates tie on the best net consensus");
+  }
+  else
+  {
+    status.summary(DiagnosticStatus::OK, "localized");
+  }
+}
+}  // namespace
+
+void diagnoseLocked(const NodeState& state, const Params& params, diagnostic_updater::DiagnosticStatusWrapper& status)
+{
+  summarize(state, status);
+  const NodeStatistics& stats = state.stats;
+  status.add("state", state.activity);
+  status.add("readings received", state.buffer.received());
+  status.add("readings dropped", state.buffer.dropped());
+  for (const auto& drop : state.buffer.dropCounts())
+  {
+    status.add("dropped: " + drop.first, drop.second);
+  }
+  status.add("readings waiting for tf", state.buffer.pendingCount());
+  status.add("readings ready", state.buffer.resolvedCount());
+  status.add("batches solved", stats.batches_solved);
+  status.add("batches replaced before solving", stats.batches_replaced);
+  status.add("solver errors", stats.solve_errors);
+  status.add("last solve time [s]", stats.last_solve_time);
+  status.add("candidates", stats.last_candidates);
+  status.add("map", state.have_map ? state.map_source : std::string("(none yet)"));
+  if (params.use_map_topic)
+  {
+    status.add("maps received", stats.maps_received);
+    status.add("maps in use", stats.maps_accepted);
+    status.add("maps rejected", stats.maps_rejected);
+    status.add("maps replaced before conversion", stats.maps_replaced);
+    status.add("last map error", stats.last_map_error);
+  }
+}
+
+}  // namespace fdml_localization

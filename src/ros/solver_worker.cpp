@@ -1,0 +1,293 @@
+#include "fdml_localization/ros/solver_worker.h"
+
+#include "fdml_localization/core/localization/ranking.h"
+#include "fdml_localization/core/util/stopwatch.h"
+#include "fdml_localization/ros/conversions.h"
+
+#include <ros/ros.h>
+
+#include <chrono>
+#include <cstdio>
+#include <utility>
+
+namespace fdml_localization
+{
+namespace
+{
+ros::Time stampToTime(std::int64_t stamp)
+{
+  ros::Time time;
+  time.fromNSec(static_cast<std::uint64_t>(std::max<std::int64_t>(stamp, 0)));
+  return time;
+}
+}  // namespace
+
+SolverWorker::SolverWorker(const Params& params, NodeState& state, ResultPublisher& publisher, const LoadedMap& map,
+                           std::string map_topic)
+  : params_(params), state_(state), publisher_(publisher), map_topic_(std::move(map_topic)), map_(map.map)
+{
+  if (map.map)
+  {
+    if (!map.summary.empty())
+    {
+      ROS_INFO("fdml_localizer: map converted from %s", map.summary.c_str());
+    }
+    localizer_.reset(new core::Localizer(map.map, optionsFor(map)));
+    publisher_.publishMapMarkers(*map_);
+  }
+}
+
+SolverWorker::~SolverWorker()
+{
+  if (thread_.joinable())
+  {
+    thread_.join();
+  }
+}
+
+void SolverWorker::start()
+{
+  thread_ = std::thread(&SolverWorker::loop, this);
+}
+
+std::string SolverWorker::noMapMessage() const
+{
+  return "no map yet: waiting for a nav_msgs/OccupancyGrid on " + map_topic_ +
+         " (~use_map_topic is true and no ~map_file was given)";
+}
+
+void SolverWorker::loop()
+{
+  if (localizer_)
+  {
+    try
+    {
+      const auto start = std::chrono::steady_clock::now();
+      localizer_->prepare();
+      ROS_INFO("fdml_localizer: localizer ready (%s engine, tables in %.2f s)", params_.engine.c_str(),
+               core::secondsSince(start));
+    }
+    catch (const std::exception& error)
+    {
+      ROS_ERROR("fdml_localizer: preparing the localizer failed: %s", error.what());
+    }
+  }
+  {
+    std::lock_guard<std::mutex> lock(state_.mutex);
+    state_.activity = localizer_ ? "idle" : "waiting for a map";
+  }
+  Job job;
+  nav_msgs::OccupancyGrid::ConstPtr map;
+  while (takeWork(&job, &map))
+  {
+    if (map)
+    {
+      applyMap(map);
+      map.reset();
+      continue;
+    }
+    Outcome outcome;
+    outcome.message = noMapMessage();
+    if (localizer_)
+    {
+      outcome = solve(job);
+    }
+    for (const OutcomePromise& waiter : job.waiters)
+    {
+      waiter->set_value(outcome);
+    }
+  }
+}
+
+bool SolverWorker::takeWork(Job* job, nav_msgs::OccupancyGrid::ConstPtr* map)
+{
+  std::unique_lock<std::mutex> lock(state_.mutex);
+  state_.work_ready.wait(lock, [this] {
+    return state_.shutting_down || state_.pending_map || state_.queued_batch || !state_.queued_requests.empty();
+  });
+  if (state_.shutting_down)
+  {
+    return false;
+  }
+  if (state_.pending_map)
+  {
+    // A new map goes first: every solve after it uses it.
+    map->swap(state_.pending_map);
+    state_.activity = "converting a map from " + map_topic_;
+  }
+  else if (!state_.queued_requests.empty())
+  {
+    *job = std::move(state_.queued_requests.front());
+    state_.queued_requests.pop_front();
+  }
+  else
+  {
+    *job = std::move(*state_.queued_batch);
+    state_.queued_batch.reset();
+    state_.activity = "solving a batch";
+  }
+  return true;
+}
+
+Outcome SolverWorker::solve(const Job& job)
+{
+  Outcome outcome;
+  core::Result result;
+  bool solved = false;
+  try
+  {
+    result = localizer_->localize(job.readings);
+    solved = true;
+  }
+  catch (const std::exception& error)
+  {
+    const bool invalid = dynamic_cast<const core::InvalidInput*>(&error) != nullptr;
+    outcome.message = std::string(invalid ? "invalid readings: " : "the solver failed: ") + error.what();
+  }
+  const bool unambiguous = solved && core::isUnambiguous(result);
+  outcome.result = toResultMsg(result);
+  outcome.result.header.frame_id = params_.global_frame_id;
+  outcome.result.header.stamp = job.from_sensors ? stampToTime(job.batch.newest_stamp) : ros::Time::now();
+  if (job.from_sensors)
+  {
+    // Like ~candidates, the result's poses are the robot's at its stamp (the newest reading).
+    for (std::size_t i = 0; i < result.candidates.size(); ++i)
+    {
+      outcome.result.candidates[i].pose =
+          toPoseMsg(carryForward(result.candidates[i].pose, job.batch.base_first, job.batch.base_newest));
+    }
+  }
+  if (solved)
+  {
+    outcome.success = !result.candidates.empty();
+    outcome.message = describeOutcome(result, unambiguous);
+  }
+  core::Pose2 map_to_odom;
+  const bool vouched = recordBatch(job, result, solved, unambiguous, &outcome, &map_to_odom);
+  if (job.from_sensors)
+  {
+    publisher_.publishBatch(job, result, outcome, unambiguous, *map_);
+  }
+  if (vouched && params_.publish_tf)
+  {
+    publisher_.publishMapToOdom(map_to_odom);
+  }
+  // Continuous mode solves many batches a second: its per-batch line is a debug message.
+  const bool quiet = job.from_sensors && solveMode(params_) == SolveMode::Continuous;
+  ROS_LOG(quiet ? ros::console::levels::Debug : ros::console::levels::Info, ROSCONSOLE_DEFAULT_NAME,
+          "fdml_localizer: %s: %s (%.3f s)", job.from_sensors ? "batch" : "~localize", outcome.message.c_str(),
+          result.times.total);
+  return outcome;
+}
+
+std::string SolverWorker::describeOutcome(const core::Result& result, bool unambiguous)
+{
+  char text[256];
+  if (result.candidates.empty())
+  {
+    std::snprintf(text, sizeof(text), "no pose explains at least %d of the %d readings", result.min_inliers_used,
+                  result.readings_used);
+  }
+  else
+  {
+    std::snprintf(text, sizeof(text), "%zu candidate(s); the best explains %d of %d readings (rms %.3f m), %s",
+                  result.candidates.size(), result.candidates[0].inliers, result.readings_used,
+                  result.candidates[0].rms_residual, unambiguous ? "unambiguous" : "ambiguous");
+  }
+  return text;
+}
+
+bool SolverWorker::recordBatch(const Job& job, const core::Result& result, bool solved, bool unambiguous,
+                               Outcome* outcome, core::Pose2* map_to_odom)
+{
+  std::lock_guard<std::mutex> lock(state_.mutex);
+  setDropCounts(state_.buffer.dropCounts(), &outcome->result);
+  if (!job.from_sensors)
+  {
+    return false;
+  }
+  NodeStatistics& stats = state_.stats;
+  ++stats.batches_solved;
+  stats.last_solve_time = result.times.total;
+  stats.last_candidates = static_cast<int>(result.candidates.size());
+  stats.last_unambiguous = unambiguous;
+  if (!solved)
+  {
+    ++stats.solve_errors;
+    stats.last_error = outcome->message;
+  }
+  if (!state_.buffer.batchRequested())
+  {
+    state_.activity = solveMode(params_) == SolveMode::Continuous ? "tracking" : "idle";
+  }
+  // A batch formed before the latest relocalization request never brings map -> odom back.
+  if (!unambiguous || job.generation != state_.generation)
+  {
+    return false;
+  }
+  state_.have_map_to_odom = true;
+  state_.map_to_odom = core::compose(result.candidates[0].pose, core::inverse(job.batch.base_first));
+  *map_to_odom = state_.map_to_odom;
+  return true;
+}
+
+core::LocalizerOptions SolverWorker::optionsFor(const LoadedMap& map) const
+{
+  if (!(map.grid_resolution > 0.0))
+  {
+    return toLocalizerOptions(params_);
+  }
+  const Params effective = withGridTolerances(params_, map.grid_resolution);
+  ROS_INFO("fdml_localizer: map from a %g m grid: range_tolerance %g m%s, agreement_tolerance %g m%s",
+           map.grid_resolution, effective.localizer.range_tolerance,
+           params_.range_tolerance_set ? " (as set)" : " (default raised to about a cell)",
+           effective.localizer.agreement_tolerance,
+           params_.agreement_tolerance_set ? " (as set)" : " (default raised to about two cells)");
+  return toLocalizerOptions(effective);
+}
+
+void SolverWorker::applyMap(const nav_msgs::OccupancyGrid::ConstPtr& msg)
+{
+  const std::string source = "topic " + map_topic_;
+  const auto start = std::chrono::steady_clock::now();
+  std::shared_ptr<const core::MapRayCaster> map;
+  std::unique_ptr<core::Localizer> localizer;
+  std::string error;
+  try
+  {
+    const LoadedMap loaded = mapFromGrid(fromOccupancyGridMsg(*msg), toGridOptions(params_), source);
+    ROS_INFO("fdml_localizer: map converted from %s: %s", source.c_str(), loaded.summary.c_str());
+    localizer.reset(new core::Localizer(loaded.map, optionsFor(loaded)));
+    localizer->prepare();
+    map = loaded.map;
+  }
+  catch (const std::exception& exception)
+  {
+    error = exception.what();
+  }
+  std::unique_lock<std::mutex> lock(state_.mutex);
+  if (!map)
+  {
+    // The error names the source (the topic).
+    ROS_ERROR_THROTTLE(10.0, "fdml_localizer: rejected a %u x %u map at %g m/cell: %s; %s", msg->info.width,
+                       msg->info.height, msg->info.resolution, error.c_str(),
+                       localizer_ ? "the previous map stays in use" : "still no map");
+    ++state_.stats.maps_rejected;
+    state_.stats.last_map_error = error;
+    state_.activity = localizer_ ? "idle" : "waiting for a map";
+    return;
+  }
+  // Between two solves: the next one uses the new map.
+  map_ = map;
+  localizer_ = std::move(localizer);
+  ROS_INFO("fdml_localizer: new map in use (%s engine, conversion and tables in %.2f s)", params_.engine.c_str(),
+           core::secondsSince(start));
+  ++state_.stats.maps_accepted;
+  state_.have_map = true;
+  state_.map_source = source;
+  state_.activity = "idle";
+  lock.unlock();
+  publisher_.publishMapMarkers(*map_);
+}
+
+}  // namespace fdml_localization

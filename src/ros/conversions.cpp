@@ -85,53 +85,6 @@ geometry_msgs::Point toPointMsg(const core::Vec2& p, double z)
   return msg;
 }
 
-nav_msgs::OccupancyGrid toOccupancyGrid(const core::MapRayCaster& caster, double resolution, const std::string& frame,
-                                        const ros::Time& stamp)
-{
-  if (!(resolution > 0.0))
-  {
-    throw std::invalid_argument("occupancy grid resolution must be > 0");
-  }
-  const core::Box2& bounds = caster.map().bounds();
-  // A margin of two cells, so the outer walls are surrounded by unknown cells.
-  const core::Vec2 origin = bounds.min - core::Vec2(2.0 * resolution, 2.0 * resolution);
-  const int width = static_cast<int>(std::ceil(bounds.size().x() / resolution)) + 4;
-  const int height = static_cast<int>(std::ceil(bounds.size().y() / resolution)) + 4;
-  nav_msgs::OccupancyGrid grid;
-  grid.header.frame_id = frame;
-  grid.header.stamp = stamp;
-  grid.info.map_load_time = stamp;
-  grid.info.resolution = static_cast<float>(resolution);
-  grid.info.width = static_cast<std::uint32_t>(width);
-  grid.info.height = static_cast<std::uint32_t>(height);
-  grid.info.origin.position = toPointMsg(origin);
-  grid.info.origin.orientation.w = 1.0;
-  grid.data.resize(static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
-  const core::Ring& outer = caster.map().outer();
-  for (int row = 0; row < height; ++row)
-  {
-    for (int col = 0; col < width; ++col)
-    {
-      core::Box2 cell;
-      cell.extend(origin + core::Vec2(col * resolution, row * resolution));
-      cell.extend(origin + core::Vec2((col + 1) * resolution, (row + 1) * resolution));
-      const core::Vec2 centre = origin + core::Vec2((col + 0.5) * resolution, (row + 0.5) * resolution);
-      std::int8_t value = 0;
-      if (caster.grid().anySegmentInBox(cell))
-      {
-        value = 100;
-      }
-      else if (!caster.isFree(centre))
-      {
-        value = core::pointInRing(centre, outer) ? 100 : -1;
-      }
-      grid.data[static_cast<std::size_t>(row) * static_cast<std::size_t>(width) + static_cast<std::size_t>(col)] =
-          value;
-    }
-  }
-  return grid;
-}
-
 core::OccupancyGrid fromOccupancyGridMsg(const nav_msgs::OccupancyGrid& msg)
 {
   core::OccupancyGrid grid;

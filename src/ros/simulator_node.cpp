@@ -1,6 +1,7 @@
 #include "fdml_localization/ros/simulator_node.h"
 
 #include "fdml_localization/ReadingTruth.h"
+#include "fdml_localization/core/map/grid/grid_raster.h"
 #include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/ros/conversions.h"
 #include "fdml_localization/ros/markers.h"
@@ -329,7 +330,13 @@ void SimulatorNode::publishLatched()
   }
   if (config_.visualization.occupancy_grid)
   {
-    grid_pub_.publish(toOccupancyGrid(*map_, config_.visualization.grid_resolution, config_.frames.map, base_stamp_));
+    // A floor plan (core::rasterize): walls a cell thick, obstacles solid, unknown outside.
+    core::RasterizeOptions raster;
+    raster.resolution = config_.visualization.grid_resolution;
+    raster.margin = 2.0 * raster.resolution;
+    raster.wall_thickness = raster.resolution;
+    raster.fill_obstacles = true;
+    grid_pub_.publish(toOccupancyGridMsg(core::rasterize(map_->map(), raster), config_.frames.map, base_stamp_));
   }
 }
 

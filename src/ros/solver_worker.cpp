@@ -145,18 +145,7 @@ Outcome SolverWorker::solve(const Job& job)
     outcome.message = std::string(invalid ? "invalid readings: " : "the solver failed: ") + error.what();
   }
   const bool unambiguous = solved && core::isUnambiguous(result);
-  outcome.result = toResultMsg(result);
-  outcome.result.header.frame_id = params_.global_frame_id;
-  outcome.result.header.stamp = job.from_sensors ? stampToTime(job.batch.newest_stamp) : ros::Time::now();
-  if (job.from_sensors)
-  {
-    // Like ~candidates, the result's poses are the robot's at its stamp (the newest reading).
-    for (std::size_t i = 0; i < result.candidates.size(); ++i)
-    {
-      outcome.result.candidates[i].pose =
-          toPoseMsg(carryForward(result.candidates[i].pose, job.batch.base_first, job.batch.base_newest));
-    }
-  }
+  outcome.result = resultMessage(job, result);
   if (solved)
   {
     outcome.success = !result.candidates.empty();
@@ -178,6 +167,23 @@ Outcome SolverWorker::solve(const Job& job)
           "fdml_localizer: %s: %s (%.3f s)", job.from_sensors ? "batch" : "~localize", outcome.message.c_str(),
           result.times.total);
   return outcome;
+}
+
+fdml_localization::LocalizationResult SolverWorker::resultMessage(const Job& job, const core::Result& result) const
+{
+  fdml_localization::LocalizationResult msg = toResultMsg(result);
+  msg.header.frame_id = params_.global_frame_id;
+  msg.header.stamp = job.from_sensors ? stampToTime(job.batch.newest_stamp) : ros::Time::now();
+  if (job.from_sensors)
+  {
+    // Like ~candidates, the result's poses are the robot's at its stamp (the newest reading).
+    for (std::size_t i = 0; i < result.candidates.size(); ++i)
+    {
+      msg.candidates[i].pose =
+          toPoseMsg(carryForward(result.candidates[i].pose, job.batch.base_first, job.batch.base_newest));
+    }
+  }
+  return msg;
 }
 
 std::string SolverWorker::describeOutcome(const core::Result& result, bool unambiguous)

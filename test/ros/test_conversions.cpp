@@ -49,35 +49,6 @@ TEST(Conversions, PosesAndTransformsRoundTrip)
   EXPECT_NEAR(fl::fromPose2D(unwrapped).theta, -core::kPi / 2.0, 1e-12);
 }
 
-TEST(Conversions, OccupancyGridMatchesTheMap)
-{
-  std::vector<core::Ring> rings = { { Vec2(0, 0), Vec2(2, 0), Vec2(2, 1), Vec2(0, 1) },
-                                    { Vec2(0.8, 0.3), Vec2(1.2, 0.3), Vec2(1.2, 0.7), Vec2(0.8, 0.7) } };
-  core::MapRayCaster caster(core::PolygonMap::fromRings(rings, "grid_room"));
-  const double res = 0.05;
-  const nav_msgs::OccupancyGrid grid = fl::toOccupancyGrid(caster, res, "map", ros::Time(1.0));
-  ASSERT_EQ(grid.data.size(), static_cast<std::size_t>(grid.info.width) * grid.info.height);
-  EXPECT_EQ(grid.header.frame_id, "map");
-  auto cell = [&](double x, double y) {
-    const int col = static_cast<int>(std::floor((x - grid.info.origin.position.x) / res));
-    const int row = static_cast<int>(std::floor((y - grid.info.origin.position.y) / res));
-    return grid.data[static_cast<std::size_t>(row) * grid.info.width + static_cast<std::size_t>(col)];
-  };
-  EXPECT_EQ(cell(0.4, 0.5), 0);     // free
-  EXPECT_EQ(cell(1.0, 0.5), 100);   // inside the hole
-  EXPECT_EQ(cell(0.8, 0.5), 100);   // on the hole's wall
-  EXPECT_EQ(cell(-0.08, 0.5), -1);  // outside the map
-  int free_cells = 0;
-  for (std::int8_t v : grid.data)
-  {
-    free_cells += v == 0 ? 1 : 0;
-  }
-  // Free area 2 - 0.16 = 1.84 m^2, less the cells the walls (7.6 m) touch on either side.
-  EXPECT_GT(free_cells * res * res, 1.84 - 2.0 * 7.6 * res);
-  EXPECT_LT(free_cells * res * res, 1.84);
-  EXPECT_THROW(fl::toOccupancyGrid(caster, 0.0, "map", ros::Time(1.0)), std::invalid_argument);
-}
-
 TEST(Conversions, MarkersCarryTheGeometry)
 {
   std::vector<core::Ring> rings = { { Vec2(0, 0), Vec2(2, 0), Vec2(2, 1), Vec2(0, 1) } };

@@ -60,18 +60,6 @@ core::Pose2 fromTransformMsg(const geometry_msgs::Transform& transform);
 geometry_msgs::Point toPointMsg(const core::Vec2& p, double z = 0.0);
 
 /**
- * @brief Rasterizes the map: a cell is occupied (100) when a wall passes through it or its
- *        centre is inside a hole, free (0) when its centre is in free space, unknown (-1)
- *        outside the outer boundary.
- * @param caster the map prepared for queries
- * @param resolution cell size [m] (> 0)
- * @param frame frame of the map
- * @param stamp header stamp
- */
-nav_msgs::OccupancyGrid toOccupancyGrid(const core::MapRayCaster& caster, double resolution, const std::string& frame,
-                                        const ros::Time& stamp);
-
-/**
  * @brief A nav_msgs/OccupancyGrid as a core grid: sizes, resolution and cells copied unchanged
  *        (both are row-major with row 0 at the bottom), the origin's position and its yaw (from
  *        the quaternion, see quaternionToYaw()). A message whose data size does not match

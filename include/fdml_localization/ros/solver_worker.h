@@ -44,6 +44,9 @@ private:
   /// Takes the next map or job from the shared state; false on shutdown.
   bool takeWork(Job* job, nav_msgs::OccupancyGrid::ConstPtr* map);
   Outcome solve(const Job& job);
+  /// ~result for @p result: in the map frame; for a sensor batch stamped at its newest reading,
+  /// with the poses carried forward to it by odometry.
+  fdml_localization::LocalizationResult resultMessage(const Job& job, const core::Result& result) const;
   /// The human-readable outcome of a solve.
   static std::string describeOutcome(const core::Result& result, bool unambiguous);
   /// Adds the drop counts to @p outcome and records a solved sensor batch in the shared state.

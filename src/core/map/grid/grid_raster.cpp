@@ -87,6 +87,106 @@ void addBlobs(OccupancyGrid* grid, int count, std::int8_t background, std::int8_
     ++placed;
   }
 }
+/// Sets every cell whose centre is inside @p rings (even-odd, scanline per row) to @p value.
+void fillInside(OccupancyGrid* grid, const std::vector<Ring>& rings, std::int8_t value)
+{
+  const double res = grid->resolution;
+  std::vector<double> xs;
+  for (int iy = 0; iy < grid->height; ++iy)
+  {
+    const double y = grid->origin.y + (iy + 0.5) * res;
+    xs.clear();
+    for (const Ring& ring : rings)
+    {
+      for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++)
+      {
+        const Vec2& a = ring[j];
+        const Vec2& b = ring[i];
+        if ((a.y() > y) != (b.y() > y))
+        {
+          xs.push_back(a.x() + (y - a.y()) * (b.x() - a.x()) / (b.y() - a.y()));
+        }
+      }
+    }
+    std::sort(xs.begin(), xs.end());
+    for (std::size_t k = 0; k + 1 < xs.size(); k += 2)
+    {
+      const int x0 = std::max(0, static_cast<int>(std::ceil((xs[k] - grid->origin.x) / res - 0.5)));
+      const int x1 =
+          std::min(grid->width - 1, static_cast<int>(std::ceil((xs[k + 1] - grid->origin.x) / res - 0.5)) - 1);
+      for (int ix = x0; ix <= x1; ++ix)
+      {
+        if (value != 100 || grid->at(ix, iy) != 0)
+        {
+          grid->at(ix, iy) = value;
+        }
+      }
+    }
+  }
+}
+
+/// Non-free cells within @p k cells (Chebyshev) of a free cell become occupied.
+void markWalls(OccupancyGrid* grid, int k)
+{
+  OccupancyGrid& g = *grid;
+  std::vector<char> near(g.cells.size(), 0);
+  std::vector<char> row_near(g.cells.size(), 0);
+  for (int iy = 0; iy < g.height; ++iy)
+  {
+    int last_free = -1000000;
+    for (int ix = 0; ix < g.width; ++ix)
+    {
+      last_free = g.at(ix, iy) == 0 ? ix : last_free;
+      row_near[g.index(ix, iy)] = ix - last_free <= k;
+    }
+    last_free = 1000000;
+    for (int ix = g.width - 1; ix >= 0; --ix)
+    {
+      last_free = g.at(ix, iy) == 0 ? ix : last_free;
+      row_near[g.index(ix, iy)] |= last_free - ix <= k;
+    }
+  }
+  for (int ix = 0; ix < g.width; ++ix)
+  {
+    for (int iy = 0; iy < g.height; ++iy)
+    {
+      for (int d = -k; d <= k && !near[g.index(ix, iy)]; ++d)
+      {
+        near[g.index(ix, iy)] = g.inside(ix, iy + d) && row_near[g.index(ix, iy + d)];
+      }
+    }
+  }
+  for (std::size_t i = 0; i < g.cells.size(); ++i)
+  {
+    if (g.cells[i] != 0 && near[i])
+    {
+      g.cells[i] = 100;
+    }
+  }
+}
+
+/// Each free cell touching an occupied one turns occupied with probability @p p.
+void addBoundaryNoise(OccupancyGrid* grid, double p, std::mt19937_64& rng)
+{
+  std::vector<std::size_t> bumps;
+  for (int iy = 1; iy + 1 < grid->height; ++iy)
+  {
+    for (int ix = 1; ix + 1 < grid->width; ++ix)
+    {
+      const OccupancyGrid& g = *grid;
+      const bool touches = g.at(ix, iy) == 0 && (g.at(ix - 1, iy) == 100 || g.at(ix + 1, iy) == 100 ||
+                                                 g.at(ix, iy - 1) == 100 || g.at(ix, iy + 1) == 100);
+      if (touches && uniform(rng) < p)
+      {
+        bumps.push_back(g.index(ix, iy));
+      }
+    }
+  }
+  for (std::size_t i : bumps)
+  {
+    grid->cells[i] = 100;
+  }
+}
 }  // namespace
 
 OccupancyGrid rasterize(const PolygonMap& map, const RasterizeOptions& options)
@@ -105,92 +205,19 @@ OccupancyGrid rasterize(const PolygonMap& map, const RasterizeOptions& options)
   grid.height = static_cast<int>(std::ceil((bounds.size().y() + 2.0 * options.margin) / res));
   grid.cells.assign(static_cast<std::size_t>(grid.width) * grid.height, -1);
 
-  // Free cells: centre inside the free space (even-odd scanline over every ring's edges).
-  std::vector<double> xs;
-  for (int iy = 0; iy < grid.height; ++iy)
+  // Free cells: centre inside the free space (even-odd over every ring's edges).
+  fillInside(&grid, map.rings(), 0);
+  // Walls: non-free cells within wall_thickness of a free cell.
+  markWalls(&grid, static_cast<int>(std::ceil(options.wall_thickness / res)));
+  if (options.fill_obstacles)
   {
-    const double y = grid.origin.y + (iy + 0.5) * res;
-    xs.clear();
-    for (const Ring& ring : map.rings())
-    {
-      for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++)
-      {
-        const Vec2& a = ring[j];
-        const Vec2& b = ring[i];
-        if ((a.y() > y) != (b.y() > y))
-        {
-          xs.push_back(a.x() + (y - a.y()) * (b.x() - a.x()) / (b.y() - a.y()));
-        }
-      }
-    }
-    std::sort(xs.begin(), xs.end());
-    for (std::size_t k = 0; k + 1 < xs.size(); k += 2)
-    {
-      const int x0 = std::max(0, static_cast<int>(std::ceil((xs[k] - grid.origin.x) / res - 0.5)));
-      const int x1 = std::min(grid.width - 1, static_cast<int>(std::ceil((xs[k + 1] - grid.origin.x) / res - 0.5)) - 1);
-      for (int ix = x0; ix <= x1; ++ix)
-      {
-        grid.at(ix, iy) = 0;
-      }
-    }
+    // A floor plan: every non-free cell inside the outer boundary is occupied.
+    fillInside(&grid, { map.outer() }, 100);
   }
-  // Walls: non-free cells within wall_thickness (Chebyshev, in cells) of a free cell.
-  const int k = static_cast<int>(std::ceil(options.wall_thickness / res));
-  std::vector<char> near(grid.cells.size(), 0);
-  std::vector<char> row_near(grid.cells.size(), 0);
-  for (int iy = 0; iy < grid.height; ++iy)
-  {
-    int last_free = -1000000;
-    for (int ix = 0; ix < grid.width; ++ix)
-    {
-      last_free = grid.at(ix, iy) == 0 ? ix : last_free;
-      row_near[grid.index(ix, iy)] = ix - last_free <= k;
-    }
-    last_free = 1000000;
-    for (int ix = grid.width - 1; ix >= 0; --ix)
-    {
-      last_free = grid.at(ix, iy) == 0 ? ix : last_free;
-      row_near[grid.index(ix, iy)] |= last_free - ix <= k;
-    }
-  }
-  for (int ix = 0; ix < grid.width; ++ix)
-  {
-    for (int iy = 0; iy < grid.height; ++iy)
-    {
-      for (int d = -k; d <= k && !near[grid.index(ix, iy)]; ++d)
-      {
-        near[grid.index(ix, iy)] = grid.inside(ix, iy + d) && row_near[grid.index(ix, iy + d)];
-      }
-    }
-  }
-  for (std::size_t i = 0; i < grid.cells.size(); ++i)
-  {
-    if (grid.cells[i] != 0 && near[i])
-    {
-      grid.cells[i] = 100;
-    }
-  }
-
   std::mt19937_64 rng(options.seed);
   if (options.boundary_noise > 0.0)
   {
-    std::vector<std::size_t> bumps;
-    for (int iy = 1; iy + 1 < grid.height; ++iy)
-    {
-      for (int ix = 1; ix + 1 < grid.width; ++ix)
-      {
-        const bool touches = grid.at(ix, iy) == 0 && (grid.at(ix - 1, iy) == 100 || grid.at(ix + 1, iy) == 100 ||
-                                                      grid.at(ix, iy - 1) == 100 || grid.at(ix, iy + 1) == 100);
-        if (touches && uniform(rng) < options.boundary_noise)
-        {
-          bumps.push_back(grid.index(ix, iy));
-        }
-      }
-    }
-    for (std::size_t i : bumps)
-    {
-      grid.cells[i] = 100;
-    }
+    addBoundaryNoise(&grid, options.boundary_noise, rng);
   }
   addBlobs(&grid, options.specks, 0, 100, rng);
   addBlobs(&grid, options.islands, -1, 0, rng);

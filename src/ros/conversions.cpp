@@ -10,6 +10,13 @@
 
 namespace fdml_localization
 {
+ros::Time stampToTime(std::int64_t stamp)
+{
+  ros::Time time;
+  time.fromNSec(static_cast<std::uint64_t>(std::max<std::int64_t>(stamp, 0)));
+  return time;
+}
+
 geometry_msgs::Pose2D toPose2D(const core::Pose2& pose)
 {
   geometry_msgs::Pose2D msg;

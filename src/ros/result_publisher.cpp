@@ -13,16 +13,6 @@
 
 namespace fdml_localization
 {
-namespace
-{
-ros::Time stampToTime(std::int64_t stamp)
-{
-  ros::Time time;
-  time.fromNSec(static_cast<std::uint64_t>(std::max<std::int64_t>(stamp, 0)));
-  return time;
-}
-}  // namespace
-
 core::Pose2 carryForward(const core::Pose2& pose, const core::Pose2& base_first, const core::Pose2& base_newest)
 {
   return core::compose(pose, core::between(base_first, base_newest));

@@ -167,8 +167,7 @@ void SensorInput::scanCallback(const sensor_msgs::LaserScan::ConstPtr& msg)
 
 LookupStatus SensorInput::lookupInOdom(const std::string& frame, std::int64_t stamp, core::Pose2* pose) const
 {
-  ros::Time time;
-  time.fromNSec(static_cast<std::uint64_t>(stamp));
+  const ros::Time time = stampToTime(stamp);
   try
   {
     if (!tf_.canTransform(params_.odom_frame_id, frame, time))

@@ -12,16 +12,6 @@
 
 namespace fdml_localization
 {
-namespace
-{
-ros::Time stampToTime(std::int64_t stamp)
-{
-  ros::Time time;
-  time.fromNSec(static_cast<std::uint64_t>(std::max<std::int64_t>(stamp, 0)));
-  return time;
-}
-}  // namespace
-
 SolverWorker::SolverWorker(const Params& params, NodeState& state, ResultPublisher& publisher, const LoadedMap& map,
                            std::string map_topic)
   : params_(params), state_(state), publisher_(publisher), map_topic_(std::move(map_topic)), map_(map.map)

@@ -35,6 +35,9 @@
 
 namespace fdml_localization
 {
+/// A reading stamp [ns since the epoch] as a ros::Time (negative stamps clamp to 0).
+ros::Time stampToTime(std::int64_t stamp);
+
 /// Pose2 -> geometry_msgs/Pose2D.
 geometry_msgs::Pose2D toPose2D(const core::Pose2& pose);
 /// geometry_msgs/Pose2D -> Pose2 (theta wrapped to [-pi, pi)).

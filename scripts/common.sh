@@ -27,7 +27,13 @@ make_workspace() {
 
 catkin_build() {
   make_workspace
-  (cd "$WS" && catkin_make -j"$JOBS" \
+  # ccache, where installed, shares objects between checkouts (paths relative to the parent).
+  local launcher=()
+  if command -v ccache >/dev/null 2>&1; then
+    export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$(dirname "$REPO_DIR")}"
+    launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+  fi
+  (cd "$WS" && catkin_make -j"$JOBS" "${launcher[@]}" \
       -DCMAKE_BUILD_TYPE=Release \
       -DPYTHON_EXECUTABLE=/usr/bin/python3 \
       -DCATKIN_ENABLE_TESTING=ON "$@")

@@ -1,5 +1,6 @@
 #include "fdml_localization/core/localization/localizer.h"
 
+#include "fdml_localization/core/geometry/cone_cast.h"
 #include "fdml_localization/core/localization/adaptive/adaptive_engine.h"
 
 #include "fdml_localization/core/localization/voxel/voxel_engine.h"
@@ -154,6 +155,10 @@ void validateReadings(const std::vector<Reading>& readings, const LocalizerOptio
     if (std::isinf(r.range) && !std::isfinite(r.max_range))
     {
       throw InvalidInput(which + "no return (range = inf) needs a finite max_range");
+    }
+    if (!(r.half_angle >= 0.0 && r.half_angle <= kMaxConeHalfAngle))
+    {
+      throw InvalidInput(which + "half_angle " + number(r.half_angle) + " rad must be in [0, pi/2]");
     }
     if (std::isfinite(r.range) && r.range > r.max_range)
     {

@@ -33,6 +33,9 @@ struct Reading
   double range = kInf;
   /// The sensor's maximum range [m]; +inf when unknown.
   double max_range = kInf;
+  /// Half the sensor's field of view [rad] in [0, pi/2]: the reading is the nearest map point
+  /// within [gtheta - a, gtheta + a] (cone_cast.h); 0 = a ray.
+  double half_angle = 0.0;
 };
 
 enum class Method

@@ -76,6 +76,62 @@ inline double distanceToSegment(const Vec2& p, const Vec2& a, const Vec2& b)
   return (a + t * e - p).norm();
 }
 
+/// One edge of a ring, for strictRingProblem().
+struct RingEdge
+{
+  std::size_t ring, index, count;
+  Vec2 a, b;
+};
+
+/// The problem of one pair of edges (they meet, or their rings are too close); empty if none.
+inline std::string ringEdgePairProblem(const RingEdge& e, const RingEdge& f, double min_gap)
+{
+  if (e.ring == f.ring)
+  {
+    const std::size_t step = (f.index + e.count - e.index) % e.count;
+    if (step == 1 || step == e.count - 1)
+    {
+      return "";  // consecutive edges share their common vertex
+    }
+  }
+  if (closedSegmentsMeet(e.a, e.b, f.a, f.b))
+  {
+    return "ring " + std::to_string(e.ring) + " edge " + std::to_string(e.index) + " meets ring " +
+           std::to_string(f.ring) + " edge " + std::to_string(f.index);
+  }
+  if (e.ring != f.ring)
+  {
+    const double gap = std::min({ distanceToSegment(e.a, f.a, f.b), distanceToSegment(e.b, f.a, f.b),
+                                  distanceToSegment(f.a, e.a, e.b), distanceToSegment(f.b, e.a, e.b) });
+    if (gap < min_gap)
+    {
+      return "rings " + std::to_string(e.ring) + " and " + std::to_string(f.ring) + " are only " + std::to_string(gap) +
+             " m apart";
+    }
+  }
+  return "";
+}
+
+/// Every hole inside the outer ring and outside the other holes; empty if so.
+inline std::string holeNestingProblem(const std::vector<Ring>& rings)
+{
+  for (std::size_t r = 1; r < rings.size(); ++r)
+  {
+    if (!pointInRing(rings[r][0], rings[0]))
+    {
+      return "hole " + std::to_string(r) + " is outside the outer ring";
+    }
+    for (std::size_t q = 1; q < rings.size(); ++q)
+    {
+      if (q != r && pointInRing(rings[r][0], rings[q]))
+      {
+        return "hole " + std::to_string(r) + " is inside hole " + std::to_string(q);
+      }
+    }
+  }
+  return "";
+}
+
 /**
  * @brief Empty when the rings form a valid map in the strict sense used by this project:
  *        every ring simple (only consecutive edges share their common vertex), no two rings
@@ -84,12 +140,7 @@ inline double distanceToSegment(const Vec2& p, const Vec2& a, const Vec2& b)
  */
 inline std::string strictRingProblem(const std::vector<Ring>& rings, double min_gap)
 {
-  struct Edge
-  {
-    std::size_t ring, index, count;
-    Vec2 a, b;
-  };
-  std::vector<Edge> edges;
+  std::vector<RingEdge> edges;
   for (std::size_t r = 0; r < rings.size(); ++r)
   {
     const std::size_t n = rings[r].size();
@@ -106,48 +157,14 @@ inline std::string strictRingProblem(const std::vector<Ring>& rings, double min_
   {
     for (std::size_t j = i + 1; j < edges.size(); ++j)
     {
-      const Edge& e = edges[i];
-      const Edge& f = edges[j];
-      if (e.ring == f.ring)
+      const std::string problem = ringEdgePairProblem(edges[i], edges[j], min_gap);
+      if (!problem.empty())
       {
-        const std::size_t step = (f.index + e.count - e.index) % e.count;
-        if (step == 1 || step == e.count - 1)
-        {
-          continue;  // consecutive edges share their common vertex
-        }
-      }
-      if (closedSegmentsMeet(e.a, e.b, f.a, f.b))
-      {
-        return "ring " + std::to_string(e.ring) + " edge " + std::to_string(e.index) + " meets ring " +
-               std::to_string(f.ring) + " edge " + std::to_string(f.index);
-      }
-      if (e.ring != f.ring)
-      {
-        const double gap = std::min({ distanceToSegment(e.a, f.a, f.b), distanceToSegment(e.b, f.a, f.b),
-                                      distanceToSegment(f.a, e.a, e.b), distanceToSegment(f.b, e.a, e.b) });
-        if (gap < min_gap)
-        {
-          return "rings " + std::to_string(e.ring) + " and " + std::to_string(f.ring) + " are only " +
-                 std::to_string(gap) + " m apart";
-        }
+        return problem;
       }
     }
   }
-  for (std::size_t r = 1; r < rings.size(); ++r)
-  {
-    if (!pointInRing(rings[r][0], rings[0]))
-    {
-      return "hole " + std::to_string(r) + " is outside the outer ring";
-    }
-    for (std::size_t q = 1; q < rings.size(); ++q)
-    {
-      if (q != r && pointInRing(rings[r][0], rings[q]))
-      {
-        return "hole " + std::to_string(r) + " is inside hole " + std::to_string(q);
-      }
-    }
-  }
-  return "";
+  return holeNestingProblem(rings);
 }
 
 }  // namespace test

@@ -2,6 +2,10 @@
 
 #include <ros/package.h>
 
+#include <cmath>
+#include <limits>
+#include <sstream>
+
 namespace fdml_localization
 {
 core::ParamValue fromXmlRpc(const XmlRpc::XmlRpcValue& value)
@@ -51,6 +55,165 @@ core::ParamValue readParamTree(const ros::NodeHandle& nh)
     return core::ParamValue::makeMap();
   }
   return fromXmlRpc(tree);
+}
+
+namespace
+{
+/// The value's type, and the value itself when a scalar, for error messages.
+std::string describeValue(const core::ParamValue& value)
+{
+  std::ostringstream out;
+  out << core::ParamValue::typeName(value.type());
+  switch (value.type())
+  {
+    case core::ParamValue::Type::Bool:
+      out << " (" << (value.asBool() ? "true" : "false") << ")";
+      break;
+    case core::ParamValue::Type::Int:
+      out << " (" << value.asInt() << ")";
+      break;
+    case core::ParamValue::Type::Double:
+      out << " (" << value.asDouble() << ")";
+      break;
+    case core::ParamValue::Type::String:
+      out << " (\"" << value.asString() << "\")";
+      break;
+    default:
+      break;
+  }
+  return out.str();
+}
+}  // namespace
+
+ParamReader::ParamReader(const core::ParamValue& tree, std::vector<std::string>* errors) : tree_(tree), errors_(errors)
+{}
+
+bool ParamReader::has(const std::string& name) const
+{
+  return tree_.find(name) != nullptr;
+}
+
+void ParamReader::typeError(const std::string& name, const std::string& expected, const core::ParamValue& value)
+{
+  errors_->push_back("~" + name + ": expected " + expected + ", got " + describeValue(value));
+}
+
+bool ParamReader::read(const std::string& name, bool* value)
+{
+  const core::ParamValue* v = tree_.find(name);
+  if (v == nullptr)
+  {
+    return false;
+  }
+  if (v->type() != core::ParamValue::Type::Bool)
+  {
+    typeError(name, "a boolean (true or false)", *v);
+    return false;
+  }
+  *value = v->asBool();
+  return true;
+}
+
+bool ParamReader::readInteger(const std::string& name, std::int64_t min, std::int64_t max, std::int64_t* value)
+{
+  const core::ParamValue* v = tree_.find(name);
+  if (v == nullptr)
+  {
+    return false;
+  }
+  const std::string expected = "an integer in [" + std::to_string(min) + ", " + std::to_string(max) + "]";
+  if (v->type() == core::ParamValue::Type::Int && v->asInt() >= min && v->asInt() <= max)
+  {
+    *value = v->asInt();
+    return true;
+  }
+  // An integral number (e.g. 10.0) is accepted; the range check comes before the conversion.
+  const double d = v->asDouble();
+  if (v->type() == core::ParamValue::Type::Double && std::isfinite(d) && d == std::floor(d) &&
+      d >= static_cast<double>(min) && d <= static_cast<double>(max))
+  {
+    *value = static_cast<std::int64_t>(d);
+    return true;
+  }
+  typeError(name, expected, *v);
+  return false;
+}
+
+bool ParamReader::read(const std::string& name, int* value)
+{
+  std::int64_t v = 0;
+  if (!readInteger(name, std::numeric_limits<int>::min(), std::numeric_limits<int>::max(), &v))
+  {
+    return false;
+  }
+  *value = static_cast<int>(v);
+  return true;
+}
+
+bool ParamReader::read(const std::string& name, long* value)
+{
+  std::int64_t v = 0;
+  if (!readInteger(name, std::numeric_limits<long>::min(), std::numeric_limits<long>::max(), &v))
+  {
+    return false;
+  }
+  *value = static_cast<long>(v);
+  return true;
+}
+
+bool ParamReader::read(const std::string& name, double* value)
+{
+  const core::ParamValue* v = tree_.find(name);
+  if (v == nullptr)
+  {
+    return false;
+  }
+  if (!v->isNumber())
+  {
+    typeError(name, "a number", *v);
+    return false;
+  }
+  *value = v->asDouble();
+  return true;
+}
+
+bool ParamReader::read(const std::string& name, std::string* value)
+{
+  const core::ParamValue* v = tree_.find(name);
+  if (v == nullptr)
+  {
+    return false;
+  }
+  if (v->type() != core::ParamValue::Type::String)
+  {
+    typeError(name, "a string", *v);
+    return false;
+  }
+  *value = v->asString();
+  return true;
+}
+
+bool ParamReader::read(const std::string& name, std::vector<double>* value)
+{
+  const core::ParamValue* v = tree_.find(name);
+  if (v == nullptr)
+  {
+    return false;
+  }
+  bool numbers_only = v->isList();
+  std::vector<double> numbers;
+  for (const core::ParamValue& item : v->items())
+  {
+    numbers_only = numbers_only && item.isNumber();
+    numbers.push_back(item.asDouble());
+  }
+  if (!numbers_only)
+  {
+    typeError(name, "a list of numbers", *v);
+    return false;
+  }
+  *value = numbers;
+  return true;
 }
 
 std::string resolveResourcePath(const std::string& url, std::string* error)

@@ -193,8 +193,10 @@ ReadingBuffer::Options bufferOptions(const Params& params)
 SensorInput::SensorInput(ros::NodeHandle& nh, const Params& params, NodeState& state, const tf2_ros::Buffer& tf)
   : params_(params), state_(state), tf_(tf)
 {
-  range_sub_ = nh.subscribe(params_.range_topic, 100, &SensorInput::rangeCallback, this);
-  scan_sub_ = nh.subscribe(params_.scan_topic, 10, &SensorInput::scanCallback, this);
+  // Queues of about a second at 1 kHz (Range) and 100 Hz (LaserScan): bounded, and deep enough
+  // that a short stall of the node does not lose readings uncounted.
+  range_sub_ = nh.subscribe(params_.range_topic, 1000, &SensorInput::rangeCallback, this);
+  scan_sub_ = nh.subscribe(params_.scan_topic, 100, &SensorInput::scanCallback, this);
 }
 
 void SensorInput::rangeCallback(const sensor_msgs::Range::ConstPtr& msg)

@@ -65,67 +65,82 @@ void MessageFuzzer::send(const sensor_msgs::Range& msg, const char* reason)
 
 void MessageFuzzer::publishRange()
 {
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const int kind = std::uniform_int_distribution<int>(0, 17)(rng_);
   sensor_msgs::Range msg = baseRange("range_sensor");
-  switch (std::uniform_int_distribution<int>(0, 17)(rng_))
+  if (kind < 8)
+  {
+    send(msg, breakRangeValues(kind, &msg));
+  }
+  else
+  {
+    publishOddHeaderRange(kind, msg);
+  }
+}
+
+const char* MessageFuzzer::breakRangeValues(int kind, sensor_msgs::Range* msg)
+{
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  switch (kind)
   {
     case 0:
-      msg.range = kNan;
-      return send(msg, "nan_range");
+      msg->range = kNan;
+      return "nan_range";
     case 1:
-      msg.range = -kInf;
-      return send(msg, "negative_infinity");
+      msg->range = -kInf;
+      return "negative_infinity";
     case 2:
-      msg.range = -static_cast<float>(std::pow(10.0, 30.0 * unit(rng_)));
-      return send(msg, "negative_range");
+      msg->range = -static_cast<float>(std::pow(10.0, 30.0 * unit(rng_)));
+      return "negative_range";
     case 3:
-      msg.min_range = kNan;
-      return send(msg, "invalid_limits");
+      msg->min_range = kNan;
+      return "invalid_limits";
     case 4:
-      msg.max_range = unit(rng_) < 0.5 ? kNan : -kInf;
-      return send(msg, "invalid_limits");
+      msg->max_range = unit(rng_) < 0.5 ? kNan : -kInf;
+      return "invalid_limits";
     case 5:
-      msg.max_range = 0.0f;
-      return send(msg, "invalid_limits");
+      msg->max_range = 0.0f;
+      return "invalid_limits";
     case 6:
-      msg.range = static_cast<float>(0.1 * unit(rng_) * 0.99);
-      return send(msg, "below_min_range");
-    case 7:
-      msg.range = static_cast<float>(4.0 + std::pow(10.0, 30.0 * unit(rng_)));
-      return send(msg, "above_max_range");
+      msg->range = static_cast<float>(0.1 * unit(rng_) * 0.99);
+      return "below_min_range";
+    default:
+      msg->range = static_cast<float>(4.0 + std::pow(10.0, 30.0 * unit(rng_)));
+      return "above_max_range";
+  }
+}
+
+void MessageFuzzer::publishOddHeaderRange(int kind, sensor_msgs::Range msg)
+{
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  switch (kind)
+  {
     case 8:
-      msg.header.frame_id = "";
+      msg.header.frame_id = unit(rng_) < 0.5 ? "" : (unit(rng_) < 0.5 ? "/" : "///");
       return send(msg, "empty_frame_id");
     case 9:
-      msg.header.frame_id = unit(rng_) < 0.5 ? "/" : "///";
-      return send(msg, "empty_frame_id");
-    case 10:
       msg.header.stamp = ros::Time();
       return send(msg, "zero_stamp");
-    case 11:
+    case 10:
       // From the future (an hour up to the end of ROS time), on the real sensor's frame.
       msg.header.stamp = unit(rng_) < 0.5 ? msg.header.stamp + ros::Duration(3600.0 + 1e6 * unit(rng_)) :
                                             ros::Time(4294967295u, 999999999u);
       return send(msg, "future_stamp");
+    case 11:
+      msg.header.frame_id = newFrame(unit(rng_) < 0.5 ? "ghost_" : "/ghost_");
+      return send(msg, "unknown_frame");
     case 12:
-      msg.header.frame_id = newFrame("ghost_");
-      return send(msg, "unknown_frame");
-    case 13:
-      msg.header.frame_id = newFrame("/ghost_");
-      return send(msg, "unknown_frame");
-    case 14:
       msg.header.frame_id = newFrame("ghost_fov_");
       msg.field_of_view = unit(rng_) < 0.5 ? kNan : (unit(rng_) < 0.5 ? kInf : -1.0f);
       ++expected_.odd_field_of_view;
       return send(msg, nullptr);
-    case 15: {
+    case 13:
+    case 14:
       // The same (unknown) frame twice, the second from the past: counted as going backwards.
       msg.header.frame_id = newFrame("past_");
       send(msg, "unknown_frame");
-      msg.header.stamp = unit(rng_) < 0.5 ? ros::Time(0, 1) : msg.header.stamp - ros::Duration(1e4 * unit(rng_) + 1.0);
+      msg.header.stamp = kind == 13 ? ros::Time(0, 1) : msg.header.stamp - ros::Duration(1e4 * unit(rng_) + 1.0);
       return send(msg, "stamp_backwards");
-    }
-    case 16:
+    case 15:
       msg.header.frame_id = newFrame("ghost_inf_");
       msg.range = kInf;  // a no-return: usable, but its frame is unknown
       return send(msg, "unknown_frame");

@@ -50,6 +50,10 @@ private:
   sensor_msgs::Range baseRange(const std::string& frame);
   std::string newFrame(const std::string& prefix);
   void send(const sensor_msgs::Range& msg, const char* reason);
+  /// Breaks a value field of @p msg (kind in [0, 7]); returns the drop reason.
+  const char* breakRangeValues(int kind, sensor_msgs::Range* msg);
+  /// Publishes @p msg with an odd frame or stamp (kind in [8, 17]).
+  void publishOddHeaderRange(int kind, sensor_msgs::Range msg);
   /// Breaks one header field of @p scan at random.
   void breakHeader(sensor_msgs::LaserScan* scan);
   /// Fills the beams at random and adds their expected drops.

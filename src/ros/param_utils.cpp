@@ -2,6 +2,7 @@
 
 #include <ros/package.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -98,121 +99,102 @@ void ParamReader::typeError(const std::string& name, const std::string& expected
   errors_->push_back("~" + name + ": expected " + expected + ", got " + describeValue(value));
 }
 
-bool ParamReader::read(const std::string& name, bool* value)
+const core::ParamValue* ParamReader::typed(const std::string& name,
+                                           const std::function<bool(const core::ParamValue&)>& accept,
+                                           const std::string& expected)
 {
   const core::ParamValue* v = tree_.find(name);
-  if (v == nullptr)
+  if (v != nullptr && !accept(*v))
   {
-    return false;
+    typeError(name, expected, *v);
+    return nullptr;
   }
-  if (v->type() != core::ParamValue::Type::Bool)
+  return v;
+}
+
+bool ParamReader::read(const std::string& name, bool* value)
+{
+  const auto* v = typed(
+      name, [](const core::ParamValue& p) { return p.type() == core::ParamValue::Type::Bool; },
+      "a boolean (true or false)");
+  if (v != nullptr)
   {
-    typeError(name, "a boolean (true or false)", *v);
-    return false;
+    *value = v->asBool();
   }
-  *value = v->asBool();
-  return true;
+  return v != nullptr;
 }
 
 bool ParamReader::readInteger(const std::string& name, std::int64_t min, std::int64_t max, std::int64_t* value)
 {
-  const core::ParamValue* v = tree_.find(name);
-  if (v == nullptr)
-  {
-    return false;
-  }
-  const std::string expected = "an integer in [" + std::to_string(min) + ", " + std::to_string(max) + "]";
-  if (v->type() == core::ParamValue::Type::Int && v->asInt() >= min && v->asInt() <= max)
-  {
-    *value = v->asInt();
-    return true;
-  }
   // An integral number (e.g. 10.0) is accepted; the range check comes before the conversion.
-  const double d = v->asDouble();
-  if (v->type() == core::ParamValue::Type::Double && std::isfinite(d) && d == std::floor(d) &&
-      d >= static_cast<double>(min) && d <= static_cast<double>(max))
+  const auto in_range = [min, max](const core::ParamValue& p) {
+    const double d = p.asDouble();
+    return (p.type() == core::ParamValue::Type::Int && p.asInt() >= min && p.asInt() <= max) ||
+           (p.type() == core::ParamValue::Type::Double && std::isfinite(d) && d == std::floor(d) &&
+            d >= static_cast<double>(min) && d <= static_cast<double>(max));
+  };
+  const auto* v = typed(name, in_range, "an integer in [" + std::to_string(min) + ", " + std::to_string(max) + "]");
+  if (v != nullptr)
   {
-    *value = static_cast<std::int64_t>(d);
-    return true;
+    *value = v->type() == core::ParamValue::Type::Int ? v->asInt() : static_cast<std::int64_t>(v->asDouble());
   }
-  typeError(name, expected, *v);
-  return false;
+  return v != nullptr;
 }
 
 bool ParamReader::read(const std::string& name, int* value)
 {
   std::int64_t v = 0;
-  if (!readInteger(name, std::numeric_limits<int>::min(), std::numeric_limits<int>::max(), &v))
-  {
-    return false;
-  }
-  *value = static_cast<int>(v);
-  return true;
+  const bool ok = readInteger(name, std::numeric_limits<int>::min(), std::numeric_limits<int>::max(), &v);
+  *value = ok ? static_cast<int>(v) : *value;
+  return ok;
 }
 
 bool ParamReader::read(const std::string& name, long* value)
 {
   std::int64_t v = 0;
-  if (!readInteger(name, std::numeric_limits<long>::min(), std::numeric_limits<long>::max(), &v))
-  {
-    return false;
-  }
-  *value = static_cast<long>(v);
-  return true;
+  const bool ok = readInteger(name, std::numeric_limits<long>::min(), std::numeric_limits<long>::max(), &v);
+  *value = ok ? static_cast<long>(v) : *value;
+  return ok;
 }
 
 bool ParamReader::read(const std::string& name, double* value)
 {
-  const core::ParamValue* v = tree_.find(name);
-  if (v == nullptr)
+  const auto* v = typed(
+      name, [](const core::ParamValue& p) { return p.isNumber(); }, "a number");
+  if (v != nullptr)
   {
-    return false;
+    *value = v->asDouble();
   }
-  if (!v->isNumber())
-  {
-    typeError(name, "a number", *v);
-    return false;
-  }
-  *value = v->asDouble();
-  return true;
+  return v != nullptr;
 }
 
 bool ParamReader::read(const std::string& name, std::string* value)
 {
-  const core::ParamValue* v = tree_.find(name);
-  if (v == nullptr)
+  const auto* v = typed(
+      name, [](const core::ParamValue& p) { return p.type() == core::ParamValue::Type::String; }, "a string");
+  if (v != nullptr)
   {
-    return false;
+    *value = v->asString();
   }
-  if (v->type() != core::ParamValue::Type::String)
-  {
-    typeError(name, "a string", *v);
-    return false;
-  }
-  *value = v->asString();
-  return true;
+  return v != nullptr;
 }
 
 bool ParamReader::read(const std::string& name, std::vector<double>* value)
 {
-  const core::ParamValue* v = tree_.find(name);
+  const auto numbers_only = [](const core::ParamValue& p) {
+    return p.isList() &&
+           std::all_of(p.items().begin(), p.items().end(), [](const core::ParamValue& i) { return i.isNumber(); });
+  };
+  const auto* v = typed(name, numbers_only, "a list of numbers");
   if (v == nullptr)
   {
     return false;
   }
-  bool numbers_only = v->isList();
-  std::vector<double> numbers;
+  value->clear();
   for (const core::ParamValue& item : v->items())
   {
-    numbers_only = numbers_only && item.isNumber();
-    numbers.push_back(item.asDouble());
+    value->push_back(item.asDouble());
   }
-  if (!numbers_only)
-  {
-    typeError(name, "a list of numbers", *v);
-    return false;
-  }
-  *value = numbers;
   return true;
 }
 

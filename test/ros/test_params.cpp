@@ -26,13 +26,7 @@ TEST(Params, DefaultsAreValidOnceTheMapIsGiven)
 TEST(Params, EachOutOfRangeValueNamesItsParameterAndRange)
 {
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  struct Case
-  {
-    const char* name;
-    std::function<void(Params&)> set;
-    const char* range;
-  };
-  const std::vector<Case> cases = {
+  const std::vector<test::ParamCase> cases = {
     { "measurements_per_batch", [](Params& p) { p.measurements_per_batch = 2; }, "[3, 255]" },
     { "measurements_per_batch", [](Params& p) { p.measurements_per_batch = 256; }, "[3, 255]" },
     { "batch_stride", [](Params& p) { p.batch_stride = 11; }, "[1, ~measurements_per_batch]" },
@@ -41,6 +35,9 @@ TEST(Params, EachOutOfRangeValueNamesItsParameterAndRange)
     { "beams_per_scan", [](Params& p) { p.beams_per_scan = 0; }, "[1, 1000]" },
     { "transform_tolerance", [](Params& p) { p.transform_tolerance = -0.1; }, "[0, 10] s" },
     { "transform_tolerance", [nan](Params& p) { p.transform_tolerance = nan; }, "[0, 10] s" },
+    { "future_tolerance", [](Params& p) { p.future_tolerance = -0.1; }, "[0, 3600] s" },
+    { "future_tolerance", [nan](Params& p) { p.future_tolerance = nan; }, "[0, 3600] s" },
+    { "max_sensor_frames", [](Params& p) { p.max_sensor_frames = 0; }, "[1, 1000000]" },
     { "relocalize_timeout", [](Params& p) { p.relocalize_timeout = 0.0; }, "(0, 3600] s" },
     { "tf_publish_rate", [](Params& p) { p.tf_publish_rate = 0.0; }, "(0, 1000] Hz" },
     { "global_frame_id", [](Params& p) { p.global_frame_id = ""; }, "non-empty" },
@@ -64,15 +61,7 @@ TEST(Params, EachOutOfRangeValueNamesItsParameterAndRange)
     { "max_boxes", [](Params& p) { p.localizer.max_boxes = 10; }, ">= 1000" },
     { "deadline", [](Params& p) { p.localizer.deadline = -1.0; }, "(0, 3600] s" },
   };
-  for (const Case& c : cases)
-  {
-    Params params = validParams();
-    c.set(params);
-    const std::vector<std::string> errors = validate(params);
-    ASSERT_EQ(errors.size(), 1u) << c.name << ": " << (errors.empty() ? "" : errors[0]);
-    EXPECT_EQ(errorsNaming(errors, c.name).size(), 1u) << errors[0];
-    EXPECT_NE(errors[0].find(c.range), std::string::npos) << errors[0];
-  }
+  test::expectEachCaseNamed(cases);
 }
 
 TEST(Params, EveryProblemIsReportedAtOnce)

@@ -36,13 +36,7 @@ TEST(Params, GridConversionParametersAreValidated)
 {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
-  struct Case
-  {
-    const char* name;
-    std::function<void(Params&)> set;
-    const char* range;
-  };
-  const std::vector<Case> cases = {
+  const std::vector<test::ParamCase> cases = {
     { "map_simplify_tolerance", [](Params& p) { p.map_simplify_tolerance = -0.01; }, "(0, 10] m" },
     { "map_simplify_tolerance", [](Params& p) { p.map_simplify_tolerance = 10.5; }, "(0, 10] m" },
     { "map_simplify_tolerance", [nan](Params& p) { p.map_simplify_tolerance = nan; }, "(0, 10] m" },
@@ -62,15 +56,7 @@ TEST(Params, GridConversionParametersAreValidated)
     { "map_occupied_threshold", [](Params& p) { p.map_occupied_threshold = 0; }, "[1, 100]" },
     { "map_occupied_threshold", [](Params& p) { p.map_occupied_threshold = 101; }, "[1, 100]" },
   };
-  for (const Case& c : cases)
-  {
-    Params params = validParams();
-    c.set(params);
-    const std::vector<std::string> errors = validate(params);
-    ASSERT_EQ(errors.size(), 1u) << c.name << ": " << (errors.empty() ? "" : errors[0]);
-    EXPECT_EQ(errorsNaming(errors, c.name).size(), 1u) << errors[0];
-    EXPECT_NE(errors[0].find(c.range), std::string::npos) << errors[0];
-  }
+  test::expectEachCaseNamed(cases);
 }
 
 TEST(Params, GridConversionLimitsReachTheCoreOptions)

@@ -11,6 +11,7 @@
 #include <xmlrpcpp/XmlRpcValue.h>
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -49,6 +50,9 @@ public:
 
 private:
   bool readInteger(const std::string& name, std::int64_t min, std::int64_t max, std::int64_t* value);
+  /// The parameter when set and accepted by @p accept; nullptr when unset, or (an error) rejected.
+  const core::ParamValue* typed(const std::string& name, const std::function<bool(const core::ParamValue&)>& accept,
+                                const std::string& expected);
   void typeError(const std::string& name, const std::string& expected, const core::ParamValue& value);
 
   const core::ParamValue& tree_;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace fdml_localization
 {
@@ -61,7 +62,7 @@ bool ReadingBuffer::add(const TimedReading& received_reading, std::string* reaso
     return false;
   }
   rememberStamp(reading.frame_id, reading.stamp);
-  pending_.push_back(reading);
+  pending_.push_back(std::move(reading));
   return true;
 }
 

@@ -50,6 +50,8 @@ void diagnoseLocked(const NodeState& state, const Params& params, diagnostic_upd
   {
     status.add("dropped: " + drop.first, drop.second);
   }
+  status.add("sensor frames tracked", state.buffer.trackedFrames());
+  status.add("sensor frames evicted", state.buffer.framesEvicted());
   status.add("readings waiting for tf", state.buffer.pendingCount());
   status.add("readings ready", state.buffer.resolvedCount());
   status.add("batches solved", stats.batches_solved);

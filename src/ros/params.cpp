@@ -1,5 +1,8 @@
 #include "fdml_localization/ros/params.h"
 
+#include "fdml_localization/ros/param_utils.h"
+#include "fdml_localization/ros/reading_buffer.h"
+
 #include <ros/node_handle.h>
 
 #include <algorithm>
@@ -76,22 +79,22 @@ const char* toString(SolveMode mode)
   return mode == SolveMode::Continuous ? "continuous" : "on_request";
 }
 
-std::vector<std::string> validate(const Params& p)
+namespace
 {
-  std::vector<std::string> errors;
+void validateMapParams(const Params& p, std::vector<std::string>* errors)
+{
   if (p.map_file.empty() && !p.use_map_topic)
   {
-    errors.push_back("~map_file is required unless ~use_map_topic is true: a .poly or map_server .yaml path, "
-                     "absolute or package://fdml_localization/maps/...");
+    errors->push_back("~map_file is required unless ~use_map_topic is true: a .poly or map_server .yaml path, "
+                      "absolute or package://fdml_localization/maps/...");
   }
-  check(&errors, finiteIn(p.map_simplify_tolerance, 0.0, 10.0), "map_simplify_tolerance", p.map_simplify_tolerance,
+  check(errors, finiteIn(p.map_simplify_tolerance, 0.0, 10.0), "map_simplify_tolerance", p.map_simplify_tolerance,
         "0 (one cell) or (0, 10] m");
-  check(&errors, !std::isnan(p.map_min_area) && p.map_min_area <= 1e6, "map_min_area", p.map_min_area,
+  check(errors, !std::isnan(p.map_min_area) && p.map_min_area <= 1e6, "map_min_area", p.map_min_area,
         "< 0 (ten cells' area) or [0, 1e6] m^2");
   const bool seed_ok =
-      !p.map_seed_point_malformed &&
-      (p.map_seed_point.empty() ||
-       (p.map_seed_point.size() == 2 && std::isfinite(p.map_seed_point[0]) && std::isfinite(p.map_seed_point[1])));
+      p.map_seed_point.empty() ||
+      (p.map_seed_point.size() == 2 && std::isfinite(p.map_seed_point[0]) && std::isfinite(p.map_seed_point[1]));
   if (!seed_ok)
   {
     std::ostringstream out;
@@ -101,44 +104,68 @@ std::vector<std::string> validate(const Params& p)
       out << (i ? ", " : "") << p.map_seed_point[i];
     }
     out << "] is out of range; allowed: a list [x, y] of two finite numbers [m] (or unset: the largest free region)";
-    errors.push_back(out.str());
+    errors->push_back(out.str());
   }
-  check(&errors, p.map_occupied_threshold >= 1 && p.map_occupied_threshold <= 100, "map_occupied_threshold",
+  check(errors, p.map_occupied_threshold >= 1 && p.map_occupied_threshold <= 100, "map_occupied_threshold",
         p.map_occupied_threshold, "an integer in [1, 100]");
+}
+
+void validateInputParams(const Params& p, std::vector<std::string>* errors)
+{
   const int k = p.measurements_per_batch;
-  check(&errors, k >= 3 && k <= 255, "measurements_per_batch", k, "an integer in [3, 255]");
-  check(&errors, p.batch_stride >= 1 && p.batch_stride <= std::max(k, 1), "batch_stride", p.batch_stride,
+  check(errors, k >= 3 && k <= 255, "measurements_per_batch", k, "an integer in [3, 255]");
+  check(errors, p.batch_stride >= 1 && p.batch_stride <= std::max(k, 1), "batch_stride", p.batch_stride,
         "an integer in [1, ~measurements_per_batch]");
   SolveMode mode;
-  check(&errors, parseSolveMode(p.mode, &mode), "mode", quoted(p.mode), "\"on_request\" or \"continuous\"");
-  check(&errors, p.beams_per_scan >= 1 && p.beams_per_scan <= 1000, "beams_per_scan", p.beams_per_scan,
+  check(errors, parseSolveMode(p.mode, &mode), "mode", quoted(p.mode), "\"on_request\" or \"continuous\"");
+  check(errors, p.beams_per_scan >= 1 && p.beams_per_scan <= 1000, "beams_per_scan", p.beams_per_scan,
         "an integer in [1, 1000]");
-  check(&errors, finiteIn(p.transform_tolerance, 0.0, 10.0), "transform_tolerance", p.transform_tolerance, "[0, 10] s");
-  check(&errors, finiteIn(p.relocalize_timeout, 1e-3, 3600.0), "relocalize_timeout", p.relocalize_timeout,
+  check(errors, finiteIn(p.transform_tolerance, 0.0, 10.0), "transform_tolerance", p.transform_tolerance, "[0, 10] s");
+  check(errors, finiteIn(p.future_tolerance, 0.0, 3600.0), "future_tolerance", p.future_tolerance, "[0, 3600] s");
+  check(errors, p.max_sensor_frames >= 1 && p.max_sensor_frames <= 1000000, "max_sensor_frames", p.max_sensor_frames,
+        "an integer in [1, 1000000]");
+  check(errors, finiteIn(p.relocalize_timeout, 1e-3, 3600.0), "relocalize_timeout", p.relocalize_timeout,
         "(0, 3600] s");
-  check(&errors, finiteIn(p.tf_publish_rate, 1e-3, 1000.0), "tf_publish_rate", p.tf_publish_rate, "(0, 1000] Hz");
-  check(&errors, validFrame(p.global_frame_id), "global_frame_id", quoted(p.global_frame_id),
-        "a non-empty frame id without spaces");
-  check(&errors, validFrame(p.odom_frame_id), "odom_frame_id", quoted(p.odom_frame_id),
-        "a non-empty frame id without spaces");
-  check(&errors, validFrame(p.base_frame_id), "base_frame_id", quoted(p.base_frame_id),
-        "a non-empty frame id without spaces");
-  check(&errors, p.odom_frame_id != p.base_frame_id && p.odom_frame_id != p.global_frame_id, "odom_frame_id",
-        quoted(p.odom_frame_id), "a frame different from ~global_frame_id and ~base_frame_id");
-  check(&errors, !p.range_topic.empty(), "range_topic", quoted(p.range_topic), "a non-empty topic name");
-  check(&errors, !p.scan_topic.empty(), "scan_topic", quoted(p.scan_topic), "a non-empty topic name");
+  check(errors, finiteIn(p.tf_publish_rate, 1e-3, 1000.0), "tf_publish_rate", p.tf_publish_rate, "(0, 1000] Hz");
+  check(errors, !p.range_topic.empty(), "range_topic", quoted(p.range_topic), "a non-empty topic name");
+  check(errors, !p.scan_topic.empty(), "scan_topic", quoted(p.scan_topic), "a non-empty topic name");
+}
 
-  check(&errors, knownName(p.engine, core::parseEngine), "engine", quoted(p.engine), "\"voxel\" or \"adaptive\"");
-  check(&errors, knownName(p.method, core::parseMethod), "method", quoted(p.method),
+void validateFrameParams(const Params& p, std::vector<std::string>* errors)
+{
+  check(errors, validFrame(p.global_frame_id), "global_frame_id", quoted(p.global_frame_id),
+        "a non-empty frame id without spaces");
+  check(errors, validFrame(p.odom_frame_id), "odom_frame_id", quoted(p.odom_frame_id),
+        "a non-empty frame id without spaces");
+  check(errors, validFrame(p.base_frame_id), "base_frame_id", quoted(p.base_frame_id),
+        "a non-empty frame id without spaces");
+  check(errors, p.odom_frame_id != p.base_frame_id && p.odom_frame_id != p.global_frame_id, "odom_frame_id",
+        quoted(p.odom_frame_id), "a frame different from ~global_frame_id and ~base_frame_id");
+}
+
+void validateCoreParams(const Params& p, std::vector<std::string>* errors)
+{
+  check(errors, knownName(p.engine, core::parseEngine), "engine", quoted(p.engine), "\"voxel\" or \"adaptive\"");
+  check(errors, knownName(p.method, core::parseMethod), "method", quoted(p.method),
         "\"robust\", \"paper\" or \"baseline\"");
-  check(&errors, p.localizer.min_inliers <= k, "min_inliers", p.localizer.min_inliers,
+  check(errors, p.localizer.min_inliers <= p.measurements_per_batch, "min_inliers", p.localizer.min_inliers,
         "0 (automatic) or an integer in [3, ~measurements_per_batch]");
   // The core options: one validation, reported under the parameters' names (k is the batch size).
   const auto parameter = [](const std::string& n) { return n == "k" ? "~measurements_per_batch" : "~" + n; };
   for (const std::string& error : core::validate(toLocalizerOptions(p), parameter))
   {
-    errors.push_back(error);
+    errors->push_back(error);
   }
+}
+}  // namespace
+
+std::vector<std::string> validate(const Params& p)
+{
+  std::vector<std::string> errors = p.type_errors;
+  validateMapParams(p, &errors);
+  validateInputParams(p, &errors);
+  validateFrameParams(p, &errors);
+  validateCoreParams(p, &errors);
   return errors;
 }
 
@@ -250,56 +277,80 @@ std::string describe(const Params& p)
   return out.str();
 }
 
-Params loadParams(const ros::NodeHandle& nh)
+namespace
+{
+void readMapParams(ParamReader& r, Params* p)
+{
+  r.read("map_file", &p->map_file);
+  r.read("use_map_topic", &p->use_map_topic);
+  r.read("map_simplify_tolerance", &p->map_simplify_tolerance);
+  r.read("map_min_area", &p->map_min_area);
+  r.read("map_seed_point", &p->map_seed_point);
+  r.read("map_occupied_threshold", &p->map_occupied_threshold);
+}
+
+void readNodeParams(ParamReader& r, Params* p)
+{
+  r.read("measurements_per_batch", &p->measurements_per_batch);
+  r.read("batch_stride", &p->batch_stride);
+  r.read("mode", &p->mode);
+  r.read("beams_per_scan", &p->beams_per_scan);
+  r.read("transform_tolerance", &p->transform_tolerance);
+  r.read("future_tolerance", &p->future_tolerance);
+  r.read("max_sensor_frames", &p->max_sensor_frames);
+  r.read("relocalize_timeout", &p->relocalize_timeout);
+  r.read("publish_tf", &p->publish_tf);
+  r.read("tf_publish_rate", &p->tf_publish_rate);
+  for (const auto& frame :
+       { std::make_pair("global_frame_id", &p->global_frame_id), std::make_pair("odom_frame_id", &p->odom_frame_id),
+         std::make_pair("base_frame_id", &p->base_frame_id) })
+  {
+    if (r.read(frame.first, frame.second))
+    {
+      *frame.second = tf2FrameId(*frame.second);
+    }
+  }
+  r.read("range_topic", &p->range_topic);
+  r.read("scan_topic", &p->scan_topic);
+}
+
+void readCoreParams(ParamReader& r, Params* p)
+{
+  core::LocalizerOptions& o = p->localizer;
+  r.read("engine", &p->engine);
+  r.read("method", &p->method);
+  r.read("resolution", &o.resolution);
+  r.read("theta_resolution", &o.theta_resolution);
+  r.read("min_inliers", &o.min_inliers);
+  p->agreement_tolerance_set = r.read("agreement_tolerance", &o.agreement_tolerance);
+  r.read("uniqueness_distance", &o.uniqueness_distance);
+  r.read("uniqueness_angle", &o.uniqueness_angle);
+  p->range_tolerance_set = r.read("range_tolerance", &o.range_tolerance);
+  r.read("max_candidates", &o.max_candidates);
+  r.read("threads", &o.threads);
+  r.read("max_boxes", &o.max_boxes);
+  r.read("deadline", &o.deadline);
+}
+}  // namespace
+
+Params paramsFromTree(const core::ParamValue& tree, const std::string& ros_home, const std::string& home)
 {
   Params p;
-  nh.param("map_file", p.map_file, p.map_file);
-  nh.param("use_map_topic", p.use_map_topic, p.use_map_topic);
-  nh.param("map_simplify_tolerance", p.map_simplify_tolerance, p.map_simplify_tolerance);
-  nh.param("map_min_area", p.map_min_area, p.map_min_area);
-  if (nh.hasParam("map_seed_point") && !nh.getParam("map_seed_point", p.map_seed_point))
-  {
-    p.map_seed_point_malformed = true;
-  }
-  nh.param("map_occupied_threshold", p.map_occupied_threshold, p.map_occupied_threshold);
-  nh.param("measurements_per_batch", p.measurements_per_batch, p.measurements_per_batch);
-  nh.param("batch_stride", p.batch_stride, p.batch_stride);
-  nh.param("mode", p.mode, p.mode);
-  nh.param("beams_per_scan", p.beams_per_scan, p.beams_per_scan);
-  nh.param("transform_tolerance", p.transform_tolerance, p.transform_tolerance);
-  nh.param("relocalize_timeout", p.relocalize_timeout, p.relocalize_timeout);
-  nh.param("publish_tf", p.publish_tf, p.publish_tf);
-  nh.param("tf_publish_rate", p.tf_publish_rate, p.tf_publish_rate);
-  nh.param("global_frame_id", p.global_frame_id, p.global_frame_id);
-  nh.param("odom_frame_id", p.odom_frame_id, p.odom_frame_id);
-  nh.param("base_frame_id", p.base_frame_id, p.base_frame_id);
-  nh.param("range_topic", p.range_topic, p.range_topic);
-  nh.param("scan_topic", p.scan_topic, p.scan_topic);
-  nh.param("engine", p.engine, p.engine);
-  nh.param("method", p.method, p.method);
-  nh.param("resolution", p.localizer.resolution, p.localizer.resolution);
-  nh.param("theta_resolution", p.localizer.theta_resolution, p.localizer.theta_resolution);
-  nh.param("min_inliers", p.localizer.min_inliers, p.localizer.min_inliers);
-  p.agreement_tolerance_set = nh.hasParam("agreement_tolerance");
-  nh.param("agreement_tolerance", p.localizer.agreement_tolerance, p.localizer.agreement_tolerance);
-  nh.param("uniqueness_distance", p.localizer.uniqueness_distance, p.localizer.uniqueness_distance);
-  nh.param("uniqueness_angle", p.localizer.uniqueness_angle, p.localizer.uniqueness_angle);
-  p.range_tolerance_set = nh.hasParam("range_tolerance");
-  nh.param("range_tolerance", p.localizer.range_tolerance, p.localizer.range_tolerance);
-  nh.param("max_candidates", p.localizer.max_candidates, p.localizer.max_candidates);
-  nh.param("threads", p.localizer.threads, p.localizer.threads);
-  int max_boxes = static_cast<int>(std::min<long>(p.localizer.max_boxes, 2147483647L));
-  nh.param("max_boxes", max_boxes, max_boxes);
-  p.localizer.max_boxes = max_boxes;
-  nh.param("deadline", p.localizer.deadline, p.localizer.deadline);
-
-  const char* home_env = std::getenv("HOME");
-  const char* ros_home_env = std::getenv("ROS_HOME");
-  const std::string home = home_env ? home_env : "";
-  const std::string ros_home = ros_home_env ? ros_home_env : "";
-  nh.param("cache_dir", p.localizer.cache_dir, defaultCacheDir(expandUser(ros_home, home), home));
+  ParamReader reader(tree, &p.type_errors);
+  readMapParams(reader, &p);
+  readNodeParams(reader, &p);
+  readCoreParams(reader, &p);
+  p.localizer.cache_dir = defaultCacheDir(expandUser(ros_home, home), home);
+  reader.read("cache_dir", &p.localizer.cache_dir);
   p.localizer.cache_dir = expandUser(p.localizer.cache_dir, home);
   return p;
+}
+
+Params loadParams(const ros::NodeHandle& nh)
+{
+  const char* home = std::getenv("HOME");
+  const char* ros_home = std::getenv("ROS_HOME");
+  return paramsFromTree(readParamTree(nh), ros_home ? ros_home : "", home ? home : "");
 }
 
 }  // namespace fdml_localization

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace fdml_localization
 {
@@ -9,10 +10,23 @@ ReadingBuffer::ReadingBuffer(const Options& options) : options_(options)
 {
   options_.batch_size = std::max(1, options_.batch_size);
   options_.stride = std::min(std::max(1, options_.stride), options_.batch_size);
+  options_.max_frames = std::max<std::size_t>(1, options_.max_frames);
+  if (!(options_.future_tolerance >= 0.0))
+  {
+    options_.future_tolerance = 0.0;
+  }
 }
 
-bool ReadingBuffer::add(const TimedReading& reading, std::string* reason)
+std::string tf2FrameId(const std::string& frame_id)
 {
+  const std::size_t first = frame_id.find_first_not_of('/');
+  return first == std::string::npos ? std::string() : frame_id.substr(first);
+}
+
+bool ReadingBuffer::add(const TimedReading& received_reading, std::string* reason)
+{
+  TimedReading reading = received_reading;
+  reading.frame_id = tf2FrameId(received_reading.frame_id);
   const char* why = nullptr;
   if (reading.frame_id.empty())
   {
@@ -22,14 +36,18 @@ bool ReadingBuffer::add(const TimedReading& reading, std::string* reason)
   {
     why = drop_reason::kZeroStamp;
   }
+  else if (static_cast<double>(reading.stamp) * 1e-9 > reading.received + options_.future_tolerance)
+  {
+    why = drop_reason::kFutureStamp;
+  }
   else if (pending_.size() >= options_.max_pending)
   {
     why = drop_reason::kBufferOverflow;
   }
   else
   {
-    auto last = last_stamp_.find(reading.frame_id);
-    if (last != last_stamp_.end() && reading.stamp < last->second)
+    const std::int64_t* last = lastStamp(reading.frame_id);
+    if (last != nullptr && reading.stamp < *last)
     {
       why = drop_reason::kStampBackwards;
     }
@@ -43,9 +61,34 @@ bool ReadingBuffer::add(const TimedReading& reading, std::string* reason)
     }
     return false;
   }
-  last_stamp_[reading.frame_id] = reading.stamp;
-  pending_.push_back(reading);
+  rememberStamp(reading.frame_id, reading.stamp);
+  pending_.push_back(std::move(reading));
   return true;
+}
+
+const std::int64_t* ReadingBuffer::lastStamp(const std::string& frame) const
+{
+  const auto it = frame_index_.find(frame);
+  return it == frame_index_.end() ? nullptr : &it->second->second;
+}
+
+void ReadingBuffer::rememberStamp(const std::string& frame, std::int64_t stamp)
+{
+  const auto it = frame_index_.find(frame);
+  if (it != frame_index_.end())
+  {
+    it->second->second = stamp;
+    last_stamps_.splice(last_stamps_.begin(), last_stamps_, it->second);
+    return;
+  }
+  last_stamps_.emplace_front(frame, stamp);
+  frame_index_.emplace(frame, last_stamps_.begin());
+  while (frame_index_.size() > options_.max_frames)
+  {
+    frame_index_.erase(last_stamps_.back().first);
+    last_stamps_.pop_back();
+    ++frames_evicted_;
+  }
 }
 
 void ReadingBuffer::countDrop(const std::string& reason, std::uint64_t count)

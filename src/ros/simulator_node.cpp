@@ -52,13 +52,41 @@ nav_msgs::Odometry odometryMsg(const core::Pose2& pose, double linear, double an
 }
 }  // namespace
 
+std::vector<std::string> simulatorFrameErrors(const core::FramesConfig& frames)
+{
+  std::vector<std::string> errors;
+  for (const auto& other : { std::make_pair("frames.odom", frames.odom), std::make_pair("frames.map", frames.map) })
+  {
+    if (other.second == frames.base)
+    {
+      errors.push_back(std::string(other.first) + " = \"" + other.second + "\" equals frames.base = \"" + frames.base +
+                       "\": the two must differ (tf cannot make the base its own parent)");
+    }
+  }
+  return errors;
+}
+
 SimulatorNode::SimulatorNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh) : nh_(nh), pnh_(pnh)
 {}
 
 bool SimulatorNode::init(std::vector<std::string>* errors)
 {
+  if (!loadScenario(errors))
+  {
+    return false;
+  }
+  start();
+  return true;
+}
+
+bool SimulatorNode::loadScenario(std::vector<std::string>* errors)
+{
   const std::size_t before = errors->size();
-  const std::vector<std::string> parse_errors = core::parseScenario(readParamTree(pnh_), &config_);
+  std::vector<std::string> parse_errors = core::parseScenario(readParamTree(pnh_), &config_);
+  if (parse_errors.empty())
+  {
+    parse_errors = simulatorFrameErrors(config_.frames);
+  }
   for (const std::string& e : parse_errors)
   {
     errors->push_back(pnh_.getNamespace() + "/" + e);
@@ -89,11 +117,11 @@ bool SimulatorNode::init(std::vector<std::string>* errors)
   {
     errors->push_back(pnh_.getNamespace() + "/" + e);
   }
-  if (!sim_)
-  {
-    return false;
-  }
+  return sim_ != nullptr;
+}
 
+void SimulatorNode::start()
+{
   range_pub_ = nh_.advertise<sensor_msgs::Range>("range", 100);
   truth_pub_ = nh_.advertise<ReadingTruth>("ground_truth_readings", 100);
   if (config_.scan.enabled)
@@ -140,7 +168,6 @@ bool SimulatorNode::init(std::vector<std::string>* errors)
   ROS_INFO("fdml_simulator: scenario '%s', map %s, %zu sensors, %zu obstacles, %s time x%.3g", config_.name.c_str(),
            map_path_.c_str(), config_.sensors.size(), sim_->scene().obstacles().size(),
            config_.publish_clock ? "simulated (/clock)" : "wall", config_.publish_clock ? config_.time_scale : 1.0);
-  return true;
 }
 
 ros::Time SimulatorNode::stampOf(double sim_time) const

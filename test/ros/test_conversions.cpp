@@ -2,7 +2,6 @@
 // simulator's, then the localizer node's (round trips and REP-117 semantics).
 #include "fdml_localization/ros/conversions.h"
 #include "fdml_localization/ros/markers.h"
-#include "fdml_localization/ros/sensor_input.h"
 #include "fdml_localization/ros/param_utils.h"
 
 #include <gtest/gtest.h>
@@ -234,100 +233,6 @@ TEST(LocalizerConversions, ResultAndCandidateMessages)
   setDropCounts({ { "nan_range", 2 }, { "stamp_backwards", 1 } }, &with_drops);
   EXPECT_EQ(with_drops.drop_reasons, std::vector<std::string>({ "nan_range", "stamp_backwards" }));
   EXPECT_EQ(with_drops.drop_counts, std::vector<uint32_t>({ 2, 1 }));
-}
-
-sensor_msgs::Range rangeMsg(double range)
-{
-  sensor_msgs::Range msg;
-  msg.header.frame_id = "sonar";
-  msg.header.stamp = ros::Time(12.5);
-  msg.min_range = 0.05;
-  msg.max_range = 4.0;
-  msg.range = static_cast<float>(range);
-  return msg;
-}
-
-TEST(LocalizerConversions, RangeFollowsRep117)
-{
-  TimedReading reading;
-  std::string reason;
-  ASSERT_TRUE(rangeToReading(rangeMsg(2.0), 13.0, &reading, &reason));
-  EXPECT_EQ(reading.frame_id, "sonar");
-  EXPECT_EQ(reading.stamp, 12500000000);
-  EXPECT_EQ(reading.range, 2.0);
-  EXPECT_EQ(reading.max_range, 4.0);
-  EXPECT_EQ(reading.received, 13.0);
-  expectPoseNear(reading.beam, core::Pose2());
-
-  ASSERT_TRUE(rangeToReading(rangeMsg(core::kInf), 13.0, &reading, &reason));
-  EXPECT_EQ(reading.range, core::kInf);
-
-  const std::pair<double, const char*> dropped[] = {
-    { kNan, drop_reason::kNanRange },      { -core::kInf, drop_reason::kNegativeInfinity },
-    { -1.0, drop_reason::kNegativeRange }, { 0.01, drop_reason::kBelowMinRange },
-    { 4.5, drop_reason::kAboveMaxRange },
-  };
-  for (const auto& entry : dropped)
-  {
-    reason.clear();
-    EXPECT_FALSE(rangeToReading(rangeMsg(entry.first), 13.0, &reading, &reason)) << entry.first;
-    EXPECT_EQ(reason, entry.second);
-  }
-  sensor_msgs::Range bad_limits = rangeMsg(1.0);
-  bad_limits.max_range = 0.0;
-  EXPECT_FALSE(rangeToReading(bad_limits, 13.0, &reading, &reason));
-  EXPECT_EQ(reason, drop_reason::kInvalidLimits);
-  // The limits themselves are inclusive.
-  EXPECT_TRUE(rangeToReading(rangeMsg(4.0), 13.0, &reading, &reason));
-}
-
-TEST(LocalizerConversions, ScanTakesEvenlySpacedUsableBeams)
-{
-  sensor_msgs::LaserScan scan;
-  scan.header.frame_id = "laser";
-  scan.header.stamp = ros::Time(100.0);
-  scan.angle_min = -core::kPi;
-  scan.angle_increment = static_cast<float>(core::kTwoPi / 360.0);
-  scan.time_increment = 0.001f;
-  scan.range_min = 0.1f;
-  scan.range_max = 10.0f;
-  scan.ranges.assign(360, 3.0f);
-  for (int i = 0; i < 360; i += 4)
-  {
-    scan.ranges[static_cast<std::size_t>(i)] = std::numeric_limits<float>::quiet_NaN();  // 90 NaN beams
-  }
-  scan.ranges[1] = std::numeric_limits<float>::infinity();  // a usable no-return
-  scan.ranges[2] = 20.0f;                                   // above range_max: dropped
-
-  std::map<std::string, std::uint64_t> drops;
-  const std::vector<TimedReading> readings = scanToReadings(scan, 10, 101.0, &drops);
-  EXPECT_EQ(drops[drop_reason::kNanRange], 90u);
-  EXPECT_EQ(drops[drop_reason::kAboveMaxRange], 1u);
-  ASSERT_EQ(readings.size(), 10u);
-  // 269 usable beams; reading j is usable beam floor(j * 269 / 10).
-  std::vector<int> usable;
-  for (int i = 0; i < 360; ++i)
-  {
-    if (i % 4 != 0 && i != 2)
-    {
-      usable.push_back(i);
-    }
-  }
-  ASSERT_EQ(usable.size(), 269u);
-  for (std::size_t j = 0; j < readings.size(); ++j)
-  {
-    const int i = usable[j * usable.size() / readings.size()];
-    EXPECT_EQ(readings[j].frame_id, "laser");
-    EXPECT_NEAR(static_cast<double>(readings[j].stamp), 100e9 + i * 1e6, 1e3);
-    EXPECT_NEAR(core::angleDiff(readings[j].beam.theta, -core::kPi + i * core::kTwoPi / 360.0), 0.0, 1e-5);
-    EXPECT_EQ(readings[j].range, i == 1 ? core::kInf : 3.0);
-    EXPECT_EQ(readings[j].max_range, 10.0);
-  }
-  EXPECT_EQ(readings[0].range, core::kInf);  // beam 1 is the first usable one
-
-  // Fewer usable beams than asked: all of them.
-  drops.clear();
-  EXPECT_EQ(scanToReadings(scan, 1000, 101.0, &drops).size(), 269u);
 }
 
 TEST(LocalizerConversions, ReadingMarkersDrawRaysFromThePoseColouredByInlier)

@@ -1,5 +1,5 @@
 // Parameter validation of the localizer node (pure, no roscore).
-#include "fdml_localization/ros/params.h"
+#include "params_test_utils.h"
 
 #include <gtest/gtest.h>
 
@@ -11,26 +11,8 @@ namespace fdml_localization
 {
 namespace
 {
-Params validParams()
-{
-  Params params;
-  params.map_file = "package://fdml_localization/maps/square_room.poly";
-  return params;
-}
-
-/// The errors mentioning "~name".
-std::vector<std::string> errorsNaming(const std::vector<std::string>& errors, const std::string& name)
-{
-  std::vector<std::string> out;
-  for (const std::string& error : errors)
-  {
-    if (error.find("~" + name + " ") != std::string::npos)
-    {
-      out.push_back(error);
-    }
-  }
-  return out;
-}
+using test::errorsNaming;
+using test::validParams;
 
 TEST(Params, DefaultsAreValidOnceTheMapIsGiven)
 {
@@ -44,13 +26,7 @@ TEST(Params, DefaultsAreValidOnceTheMapIsGiven)
 TEST(Params, EachOutOfRangeValueNamesItsParameterAndRange)
 {
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  struct Case
-  {
-    const char* name;
-    std::function<void(Params&)> set;
-    const char* range;
-  };
-  const std::vector<Case> cases = {
+  const std::vector<test::ParamCase> cases = {
     { "measurements_per_batch", [](Params& p) { p.measurements_per_batch = 2; }, "[3, 255]" },
     { "measurements_per_batch", [](Params& p) { p.measurements_per_batch = 256; }, "[3, 255]" },
     { "batch_stride", [](Params& p) { p.batch_stride = 11; }, "[1, ~measurements_per_batch]" },
@@ -59,6 +35,9 @@ TEST(Params, EachOutOfRangeValueNamesItsParameterAndRange)
     { "beams_per_scan", [](Params& p) { p.beams_per_scan = 0; }, "[1, 1000]" },
     { "transform_tolerance", [](Params& p) { p.transform_tolerance = -0.1; }, "[0, 10] s" },
     { "transform_tolerance", [nan](Params& p) { p.transform_tolerance = nan; }, "[0, 10] s" },
+    { "future_tolerance", [](Params& p) { p.future_tolerance = -0.1; }, "[0, 3600] s" },
+    { "future_tolerance", [nan](Params& p) { p.future_tolerance = nan; }, "[0, 3600] s" },
+    { "max_sensor_frames", [](Params& p) { p.max_sensor_frames = 0; }, "[1, 1000000]" },
     { "relocalize_timeout", [](Params& p) { p.relocalize_timeout = 0.0; }, "(0, 3600] s" },
     { "tf_publish_rate", [](Params& p) { p.tf_publish_rate = 0.0; }, "(0, 1000] Hz" },
     { "global_frame_id", [](Params& p) { p.global_frame_id = ""; }, "non-empty" },
@@ -82,15 +61,7 @@ TEST(Params, EachOutOfRangeValueNamesItsParameterAndRange)
     { "max_boxes", [](Params& p) { p.localizer.max_boxes = 10; }, ">= 1000" },
     { "deadline", [](Params& p) { p.localizer.deadline = -1.0; }, "(0, 3600] s" },
   };
-  for (const Case& c : cases)
-  {
-    Params params = validParams();
-    c.set(params);
-    const std::vector<std::string> errors = validate(params);
-    ASSERT_EQ(errors.size(), 1u) << c.name << ": " << (errors.empty() ? "" : errors[0]);
-    EXPECT_EQ(errorsNaming(errors, c.name).size(), 1u) << errors[0];
-    EXPECT_NE(errors[0].find(c.range), std::string::npos) << errors[0];
-  }
+  test::expectEachCaseNamed(cases);
 }
 
 TEST(Params, EveryProblemIsReportedAtOnce)
@@ -169,9 +140,9 @@ TEST(Params, CoreOptionsAreCopied)
   EXPECT_EQ(toLocalizerOptions(params).engine, core::Engine::Voxel);
 }
 
-TEST(Params, AgreesWithTheCoreValidation)
+TEST(Params, AcceptsOnlyWhatTheCoreAccepts)
 {
-  // What the node accepts, the core accepts ...
+  // What the node accepts, the core accepts.
   std::vector<std::function<void(Params&)>> accepted = {
     [](Params&) {},
     [](Params& p) {
@@ -214,7 +185,11 @@ TEST(Params, AgreesWithTheCoreValidation)
     const std::vector<std::string> core_errors = core::validate(toLocalizerOptions(params));
     EXPECT_TRUE(core_errors.empty()) << i << ": " << (core_errors.empty() ? "" : core_errors[0]);
   }
-  // ... and every core option the core rejects, the node rejects first (naming the parameter).
+}
+
+TEST(Params, RejectsWhatTheCoreRejects)
+{
+  // Every core option the core rejects, the node rejects first (naming the parameter).
   std::vector<std::function<void(Params&)>> rejected = {
     [](Params& p) { p.localizer.resolution = 15; },
     [](Params& p) { p.localizer.resolution = 1025; },
@@ -289,134 +264,6 @@ TEST(Params, DescribeListsEveryParameter)
                             "cache_dir",
                             "max_boxes",
                             "deadline" })
-  {
-    EXPECT_NE(text.find(name), std::string::npos) << name;
-  }
-}
-
-// ---------------------------------------------------------------------------------------------
-// Occupancy-grid maps (issue 9).
-// ---------------------------------------------------------------------------------------------
-
-TEST(Params, MapTopicMakesTheMapFileOptional)
-{
-  Params params;
-  params.use_map_topic = true;
-  EXPECT_TRUE(validate(params).empty());
-  params.map_file = "package://fdml_localization/maps/office_grid.yaml";  // an initial map
-  EXPECT_TRUE(validate(params).empty());
-  params.use_map_topic = false;
-  params.map_file.clear();
-  const std::vector<std::string> errors = validate(params);
-  ASSERT_EQ(errors.size(), 1u);
-  EXPECT_NE(errors[0].find("~map_file is required unless ~use_map_topic is true"), std::string::npos) << errors[0];
-}
-
-TEST(Params, GridConversionParametersAreValidated)
-{
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  const double inf = std::numeric_limits<double>::infinity();
-  struct Case
-  {
-    const char* name;
-    std::function<void(Params&)> set;
-    const char* range;
-  };
-  const std::vector<Case> cases = {
-    { "map_simplify_tolerance", [](Params& p) { p.map_simplify_tolerance = -0.01; }, "(0, 10] m" },
-    { "map_simplify_tolerance", [](Params& p) { p.map_simplify_tolerance = 10.5; }, "(0, 10] m" },
-    { "map_simplify_tolerance", [nan](Params& p) { p.map_simplify_tolerance = nan; }, "(0, 10] m" },
-    { "map_min_area", [nan](Params& p) { p.map_min_area = nan; }, "[0, 1e6] m^2" },
-    { "map_min_area", [inf](Params& p) { p.map_min_area = inf; }, "[0, 1e6] m^2" },
-    { "map_seed_point", [](Params& p) { p.map_seed_point = { 1.0 }; }, "two finite numbers" },
-    { "map_seed_point",
-      [](Params& p) {
-        p.map_seed_point = { 1.0, 2.0, 3.0 };
-      },
-      "two finite numbers" },
-    { "map_seed_point",
-      [inf](Params& p) {
-        p.map_seed_point = { 1.0, inf };
-      },
-      "two finite numbers" },
-    { "map_seed_point", [](Params& p) { p.map_seed_point_malformed = true; }, "two finite numbers" },
-    { "map_occupied_threshold", [](Params& p) { p.map_occupied_threshold = 0; }, "[1, 100]" },
-    { "map_occupied_threshold", [](Params& p) { p.map_occupied_threshold = 101; }, "[1, 100]" },
-  };
-  for (const Case& c : cases)
-  {
-    Params params = validParams();
-    c.set(params);
-    const std::vector<std::string> errors = validate(params);
-    ASSERT_EQ(errors.size(), 1u) << c.name << ": " << (errors.empty() ? "" : errors[0]);
-    EXPECT_EQ(errorsNaming(errors, c.name).size(), 1u) << errors[0];
-    EXPECT_NE(errors[0].find(c.range), std::string::npos) << errors[0];
-  }
-
-  // Limits and the "automatic" values are accepted and reach the core options.
-  Params params = validParams();
-  params.map_simplify_tolerance = 10.0;
-  params.map_min_area = -5.0;
-  params.map_seed_point = { 1.5, -2.5 };
-  params.map_occupied_threshold = 100;
-  EXPECT_TRUE(validate(params).empty());
-  core::GridConversionOptions options = toGridOptions(params);
-  EXPECT_EQ(options.tolerance, 10.0);
-  EXPECT_EQ(options.min_area, -5.0);
-  EXPECT_TRUE(options.use_seed);
-  EXPECT_EQ(options.seed_point, core::Vec2(1.5, -2.5));
-  EXPECT_EQ(options.occupied_threshold, 100);
-  params.map_seed_point.clear();
-  params.map_occupied_threshold = 1;
-  params.map_min_area = 1e6;
-  EXPECT_TRUE(validate(params).empty());
-  EXPECT_FALSE(toGridOptions(params).use_seed);
-  EXPECT_EQ(toGridOptions(params).occupied_threshold, 1);
-  // Defaults: one cell, ten cells, the largest region, as the core's defaults.
-  const core::GridConversionOptions defaults = toGridOptions(validParams());
-  const core::GridConversionOptions core_defaults;
-  EXPECT_EQ(defaults.tolerance, core_defaults.tolerance);
-  EXPECT_EQ(defaults.min_area, core_defaults.min_area);
-  EXPECT_EQ(defaults.use_seed, core_defaults.use_seed);
-  EXPECT_EQ(defaults.occupied_threshold, core_defaults.occupied_threshold);
-}
-
-TEST(Params, GridMapsWidenTheTolerancesTheUserDidNotSet)
-{
-  const Params defaults = validParams();
-  // A 5 cm grid: one cell of range tolerance, two of agreement.
-  Params grid = withGridTolerances(defaults, 0.05);
-  EXPECT_DOUBLE_EQ(grid.localizer.range_tolerance, 0.05);
-  EXPECT_DOUBLE_EQ(grid.localizer.agreement_tolerance, 0.10);
-  // A fine 1 cm grid never goes below the defaults.
-  grid = withGridTolerances(defaults, 0.01);
-  EXPECT_DOUBLE_EQ(grid.localizer.range_tolerance, defaults.localizer.range_tolerance);
-  EXPECT_DOUBLE_EQ(grid.localizer.agreement_tolerance, defaults.localizer.agreement_tolerance);
-  // A polygon map (resolution 0) changes nothing.
-  grid = withGridTolerances(defaults, 0.0);
-  EXPECT_EQ(grid.localizer.range_tolerance, defaults.localizer.range_tolerance);
-  EXPECT_EQ(grid.localizer.agreement_tolerance, defaults.localizer.agreement_tolerance);
-  // Values the user set are kept, each on its own.
-  Params set = validParams();
-  set.localizer.range_tolerance = 0.01;
-  set.range_tolerance_set = true;
-  grid = withGridTolerances(set, 0.1);
-  EXPECT_EQ(grid.localizer.range_tolerance, 0.01);
-  EXPECT_DOUBLE_EQ(grid.localizer.agreement_tolerance, 0.2);
-  set.localizer.agreement_tolerance = 0.03;
-  set.agreement_tolerance_set = true;
-  grid = withGridTolerances(set, 0.1);
-  EXPECT_EQ(grid.localizer.range_tolerance, 0.01);
-  EXPECT_EQ(grid.localizer.agreement_tolerance, 0.03);
-  // And they reach the core options.
-  EXPECT_DOUBLE_EQ(toLocalizerOptions(withGridTolerances(defaults, 0.05)).range_tolerance, 0.05);
-}
-
-TEST(Params, DescribeListsTheMapParameters)
-{
-  const std::string text = describe(validParams());
-  for (const char* name :
-       { "use_map_topic", "map_simplify_tolerance", "map_min_area", "map_seed_point", "map_occupied_threshold" })
   {
     EXPECT_NE(text.find(name), std::string::npos) << name;
   }

@@ -1,6 +1,7 @@
 // rostest: the fdml_localizer binary exits non-zero, naming the problem, for a missing map file,
-// a map_server YAML whose image is missing, an out-of-range parameter and a missing ~map_file (run as a child process
-// against the rostest's master).
+// a map_server YAML whose image is missing, an out-of-range parameter, a parameter of the wrong
+// type and a missing ~map_file; fdml_simulator does for an odometry frame equal to the base frame
+// (each run as a child process against the rostest's master).
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
@@ -19,10 +20,10 @@ struct RunResult
   std::string output;
 };
 
-/// Runs the node with @p args (at most 60 s) and returns its exit code and its stdout + stderr.
-RunResult runNode(const std::string& args)
+/// Runs @p binary with @p args (at most 60 s) and returns its exit code and its stdout + stderr.
+RunResult runBinary(const std::string& binary, const std::string& args)
 {
-  const std::string command = "timeout 60 " + std::string(FDML_LOCALIZER_BINARY) + " " + args + " 2>&1";
+  const std::string command = "timeout 60 " + binary + " " + args + " 2>&1";
   RunResult result;
   FILE* pipe = popen(command.c_str(), "r");
   if (!pipe)
@@ -37,6 +38,12 @@ RunResult runNode(const std::string& args)
   const int status = pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
+}
+
+/// Runs fdml_localizer with @p args.
+RunResult runNode(const std::string& args)
+{
+  return runBinary(FDML_LOCALIZER_BINARY, args);
 }
 
 const std::string kGoodMap = std::string(FDML_SOURCE_DIR) + "/test/data/node_test_room.poly";
@@ -66,6 +73,26 @@ TEST(LocalizerBadParams, OutOfRangeParameterExitsNonZeroNamingItAndItsRange)
   EXPECT_NE(run.output.find("~resolution = 5"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("[16, 1024]"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("~mode"), std::string::npos) << run.output;
+}
+
+TEST(LocalizerBadParams, WrongTypesExitNonZeroNamingTheParameterAndTheType)
+{
+  // Before issue 15 both were silently replaced by their defaults and the node ran.
+  const RunResult run = runNode("__name:=bad_types _map_file:=" + kGoodMap + " _resolution:=abc _mode:=3");
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_NE(run.output.find("~resolution: expected an integer"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("got a string (\"abc\")"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("~mode: expected a string, got an integer (3)"), std::string::npos) << run.output;
+}
+
+TEST(SimulatorBadParams, OdometryFrameEqualToTheBaseIsRefusedNamingBoth)
+{
+  const RunResult run = runBinary(FDML_SIMULATOR_BINARY, "__name:=bad_frames _map_file:=" + kGoodMap +
+                                                             " _scan/enabled:=true _frames/odom:=base_link "
+                                                             "_frames/base:=base_link");
+  EXPECT_NE(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.exit_code, 124) << "timed out: " << run.output;
+  EXPECT_NE(run.output.find("frames.odom = \"base_link\" equals frames.base"), std::string::npos) << run.output;
 }
 
 TEST(LocalizerBadParams, MissingMapParameterExitsNonZero)

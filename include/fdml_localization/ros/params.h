@@ -7,6 +7,7 @@
 
 #include "fdml_localization/core/map/grid/grid_to_polygon.h"
 #include "fdml_localization/core/localization/localizer.h"
+#include "fdml_localization/core/util/param_tree.h"
 
 #include <string>
 #include <vector>
@@ -42,18 +43,23 @@ struct Params
   double map_simplify_tolerance = 0.0;  ///< ~map_simplify_tolerance [m]: 0 = one cell, else (0, 10]
   double map_min_area = -1.0;           ///< ~map_min_area [m^2]: obstacles smaller are specks; < 0 = ten cells
   /// ~map_seed_point [m]: [x, y] in the map frame, keep the free region holding it; empty =
-  /// the largest free region. A malformed value is kept here as given (validate() reports it).
+  /// the largest free region. A list of another length is kept here as given (validate() reports it).
   std::vector<double> map_seed_point;
-  bool map_seed_point_malformed = false;  ///< set by loadParams() when ~map_seed_point is not a list of numbers
-  int map_occupied_threshold = 50;        ///< ~map_occupied_threshold: cells >= this are walls, [1, 100]
-  int measurements_per_batch = 10;        ///< ~measurements_per_batch: k, in [3, 255]
-  int batch_stride = 1;                   ///< ~batch_stride: readings the window slides by, in [1, k]
-  std::string mode = "on_request";        ///< ~mode: on_request | continuous
-  int beams_per_scan = 10;                ///< ~beams_per_scan: readings taken from a LaserScan, [1, 1000]
-  double transform_tolerance = 0.1;       ///< ~transform_tolerance [s]: tf wait and tf future-dating, [0, 10]
-  double relocalize_timeout = 30.0;       ///< ~relocalize_timeout [s]: default ~relocalize wait, (0, 3600]
-  bool publish_tf = false;                ///< ~publish_tf: publish map -> odom for an unambiguous best
-  double tf_publish_rate = 10.0;          ///< ~tf_publish_rate [Hz]: map -> odom republish rate, (0, 1000]
+  int map_occupied_threshold = 50;   ///< ~map_occupied_threshold: cells >= this are walls, [1, 100]
+  int measurements_per_batch = 10;   ///< ~measurements_per_batch: k, in [3, 255]
+  int batch_stride = 1;              ///< ~batch_stride: readings the window slides by, in [1, k]
+  std::string mode = "on_request";   ///< ~mode: on_request | continuous
+  int beams_per_scan = 10;           ///< ~beams_per_scan: readings taken from a LaserScan, [1, 1000]
+  double transform_tolerance = 0.1;  ///< ~transform_tolerance [s]: tf wait and tf future-dating, [0, 10]
+  /// ~future_tolerance [s]: readings stamped further ahead of the node's clock are dropped
+  /// (drop reason future_stamp), [0, 3600]
+  double future_tolerance = 0.5;
+  /// ~max_sensor_frames: sensor frames whose newest stamp is remembered (least recently seen
+  /// forgotten beyond), [1, 1000000]
+  int max_sensor_frames = 1024;
+  double relocalize_timeout = 30.0;  ///< ~relocalize_timeout [s]: default ~relocalize wait, (0, 3600]
+  bool publish_tf = false;           ///< ~publish_tf: publish map -> odom for an unambiguous best
+  double tf_publish_rate = 10.0;     ///< ~tf_publish_rate [Hz]: map -> odom republish rate, (0, 1000]
 
   // Frames (AMCL names).
   std::string global_frame_id = "map";
@@ -72,6 +78,9 @@ struct Params
   core::LocalizerOptions localizer;      ///< every other core option (engine, method: see above)
   bool agreement_tolerance_set = false;  ///< the user set ~agreement_tolerance (see withGridTolerances())
   bool range_tolerance_set = false;      ///< the user set ~range_tolerance (see withGridTolerances())
+
+  /// Parameters set with the wrong type (ParamReader messages; validate() reports them first).
+  std::vector<std::string> type_errors;
 };
 
 /**
@@ -114,10 +123,16 @@ std::string defaultCacheDir(const std::string& ros_home, const std::string& home
 std::string describe(const Params& params);
 
 /**
- * @brief Loads every parameter from @p private_nh (defaults for the missing ones; ~map_file
- *        stays empty when unset so validate() reports it). ~cache_dir defaults to
- *        defaultCacheDir() and a leading "~" is expanded with $HOME.
+ * @brief Reads every parameter from a tree of the node's private parameters (pure; ROS-free
+ *        tests give an in-memory tree). Missing parameters keep their defaults (~map_file stays
+ *        empty so validate() reports it); a value of the wrong type keeps the default and is
+ *        recorded in Params::type_errors (see ParamReader). Frame ids lose a leading '/'
+ *        (tf2FrameId()). ~cache_dir defaults to defaultCacheDir(@p ros_home, @p home) and a
+ *        leading "~" is expanded with @p home.
  */
+Params paramsFromTree(const core::ParamValue& tree, const std::string& ros_home, const std::string& home);
+
+/// paramsFromTree() on the parameters under @p private_nh, with $ROS_HOME and $HOME.
 Params loadParams(const ros::NodeHandle& private_nh);
 
 }  // namespace fdml_localization

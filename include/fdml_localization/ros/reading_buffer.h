@@ -13,8 +13,10 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <list>
 #include <map>
 #include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -32,10 +34,18 @@ constexpr const char* kInvalidLimits = "invalid_limits";                ///< min
 constexpr const char* kEmptyFrameId = "empty_frame_id";                 ///< header.frame_id is empty
 constexpr const char* kZeroStamp = "zero_stamp";                        ///< header.stamp is 0 (unusable with odometry)
 constexpr const char* kStampBackwards = "stamp_backwards";              ///< older than the last reading of its frame
+constexpr const char* kFutureStamp = "future_stamp";                    ///< stamped beyond ~future_tolerance ahead
+constexpr const char* kInvalidScan = "invalid_scan";                    ///< a LaserScan header fails its checks
 constexpr const char* kUnknownFrame = "unknown_frame";                  ///< frame never appeared on tf in time
 constexpr const char* kTransformUnavailable = "transform_unavailable";  ///< no tf at the stamp in time
 constexpr const char* kBufferOverflow = "buffer_overflow";              ///< too many readings waiting for tf
 }  // namespace drop_reason
+
+/**
+ * @brief The frame id as tf2 expects it: leading '/' removed (tf2 rejects such ids, with one
+ *        warning per lookup; tf (1) accepted them, and tf2 strips them from incoming transforms).
+ */
+std::string tf2FrameId(const std::string& frame_id);
 
 /// A reading as received, before its transforms are known.
 struct TimedReading
@@ -92,14 +102,22 @@ public:
     bool continuous = false;           ///< false: one batch per request (see requestBatch())
     double transform_tolerance = 0.1;  ///< how long a reading may wait for its transforms [s]
     std::size_t max_pending = 10000;   ///< readings waiting for tf beyond this are dropped
+    /// a reading stamped more than this ahead of its arrival time is dropped [s] (>= 0)
+    double future_tolerance = 0.5;
+    /// frames whose newest stamp is remembered (>= 1); beyond, the least recently seen is forgotten
+    std::size_t max_frames = 1024;
   };
 
   explicit ReadingBuffer(const Options& options);
 
   /**
-   * @brief Checks and queues a reading for transform resolution.
-   * Drops (and counts) an empty frame id, a zero stamp, a stamp older than the last accepted
-   * reading of the same frame, and overflow. Range validity is the converter's job.
+   * @brief Checks and queues a reading for transform resolution, its frame id as tf2FrameId().
+   * Drops (and counts) an empty frame id, a zero stamp, a stamp more than
+   * Options::future_tolerance ahead of the reading's arrival time (such a reading never becomes
+   * its frame's newest stamp), a stamp older than the last accepted reading of the same frame,
+   * and overflow. Range validity is the converter's job. The newest stamp is remembered for at
+   * most Options::max_frames frames: a new frame beyond that evicts the least recently seen one
+   * (counted by framesEvicted()), whose next reading is then accepted as a first one.
    * @param[out] reason set to the drop reason when the reading is dropped (may be null)
    * @return true when queued
    */
@@ -163,12 +181,31 @@ public:
   {
     return options_;
   }
+  /// Frames whose newest stamp is remembered (<= Options::max_frames).
+  std::size_t trackedFrames() const
+  {
+    return frame_index_.size();
+  }
+  /// Frames forgotten to keep trackedFrames() within Options::max_frames.
+  std::uint64_t framesEvicted() const
+  {
+    return frames_evicted_;
+  }
 
 private:
+  /// Remembers @p stamp as the newest of @p frame (most recently seen), evicting beyond the cap.
+  void rememberStamp(const std::string& frame, std::int64_t stamp);
+  /// The newest accepted stamp of @p frame, or nullptr when not remembered.
+  const std::int64_t* lastStamp(const std::string& frame) const;
+
+  using FrameStamps = std::list<std::pair<std::string, std::int64_t>>;
+
   Options options_;
-  std::deque<TimedReading> pending_;                ///< waiting for transforms, arrival order
-  std::deque<ResolvedReading> resolved_;            ///< ready, arrival order
-  std::map<std::string, std::int64_t> last_stamp_;  ///< newest accepted stamp per frame [ns]
+  std::deque<TimedReading> pending_;      ///< waiting for transforms, arrival order
+  std::deque<ResolvedReading> resolved_;  ///< ready, arrival order
+  FrameStamps last_stamps_;               ///< newest accepted stamp per frame [ns], most recently seen first
+  std::unordered_map<std::string, FrameStamps::iterator> frame_index_;  ///< into last_stamps_
+  std::uint64_t frames_evicted_ = 0;
   std::map<std::string, std::uint64_t> drops_;
   std::uint64_t received_ = 0;
   bool requested_ = false;

@@ -32,16 +32,35 @@ namespace fdml_localization
  */
 bool rangeToReading(const sensor_msgs::Range& msg, double received, TimedReading* reading, std::string* reason);
 
+/// The longest scan accepted: time_increment * (beams - 1) and scan_time at most this [s].
+constexpr double kMaxScanDuration = 60.0;
+/// The largest beam angle accepted in a LaserScan, in absolute value: 4 pi [rad].
+constexpr double kMaxScanAngle = 4.0 * 3.14159265358979323846;
+
 /**
- * @brief Up to @p beams evenly spaced usable beams of a scan (REP-117 per beam, as for a
- *        Range: +inf is a no-return, NaN, -inf and values outside [range_min, range_max] are
- *        unusable). Beam i is stamped
+ * @brief What is wrong with a LaserScan's header fields, naming the field; "" when usable.
+ *        Requires finite angle_min, angle_max and angle_increment, a non-zero increment whose
+ *        sign matches angle_max - angle_min, every beam angle (angle_min + i * angle_increment)
+ *        and angle_max within kMaxScanAngle in absolute value, finite non-negative
+ *        time_increment and scan_time with the scan lasting at most kMaxScanDuration, and
+ *        finite 0 <= range_min < range_max.
+ */
+std::string scanHeaderProblem(const sensor_msgs::LaserScan& msg);
+
+/**
+ * @brief Up to @p beams evenly spaced usable beams of a scan whose header passes
+ *        scanHeaderProblem() (REP-117 per beam: +inf, and a finite value above range_max, is a
+ *        no-return; NaN, -inf, negative values and values below range_min are flagged invalid
+ *        by the driver and dropped, never turned into no-returns). Beam i is stamped
  *        header.stamp + i * time_increment and posed (0, 0, angle_min + i * angle_increment)
  *        in the scan frame.
- * @param[out] drops counts of unusable beams by reason
+ * @param[out] drops counts of unusable beams by reason; a scan with a bad header counts all its
+ *             beams (at least one) as drop_reason::kInvalidScan and gives no reading
+ * @param[out] header_problem set to scanHeaderProblem() when not empty (may be null)
  */
 std::vector<TimedReading> scanToReadings(const sensor_msgs::LaserScan& msg, int beams, double received,
-                                         std::map<std::string, std::uint64_t>* drops);
+                                         std::map<std::string, std::uint64_t>* drops,
+                                         std::string* header_problem = nullptr);
 
 /// The reading buffer's options from the node's parameters.
 ReadingBuffer::Options bufferOptions(const Params& params);

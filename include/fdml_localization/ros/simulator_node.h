@@ -29,6 +29,13 @@
 
 namespace fdml_localization
 {
+/**
+ * @brief What is wrong with the simulator's frames, each message naming both parameters
+ *        (frames.odom and frames.base, frames.map and frames.base): the odometry and map frames
+ *        must differ from the base frame (tf cannot make a frame its own parent). Empty when usable.
+ */
+std::vector<std::string> simulatorFrameErrors(const core::FramesConfig& frames);
+
 class SimulatorNode
 {
 public:
@@ -53,6 +60,10 @@ public:
   }
 
 private:
+  /// Parses the scenario, loads the map and builds the simulation (init()'s first half).
+  bool loadScenario(std::vector<std::string>* errors);
+  /// Advertises the topics and services, publishes the static data and starts the timer.
+  void start();
   void onTimer(const ros::WallTimerEvent& event);
   void stepOnce();
   ros::Time stampOf(double sim_time) const;

@@ -1,5 +1,7 @@
 #include "fdml_localization/ros/params.h"
 
+#include "fdml_localization/core/map/grid/grid_tolerances.h"
+
 #include <ros/node_handle.h>
 
 #include <algorithm>
@@ -174,18 +176,8 @@ core::GridConversionOptions toGridOptions(const Params& p)
 Params withGridTolerances(const Params& params, double resolution)
 {
   Params p = params;
-  if (!(resolution > 0.0) || !std::isfinite(resolution))
-  {
-    return p;
-  }
-  if (!p.range_tolerance_set)
-  {
-    p.localizer.range_tolerance = std::max(p.localizer.range_tolerance, resolution);
-  }
-  if (!p.agreement_tolerance_set)
-  {
-    p.localizer.agreement_tolerance = std::max(p.localizer.agreement_tolerance, 2.0 * resolution);
-  }
+  p.localizer = core::withGridTolerances(params.localizer, resolution,
+                                         { params.range_tolerance_set, params.agreement_tolerance_set });
   return p;
 }
 

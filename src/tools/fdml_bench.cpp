@@ -4,6 +4,7 @@
 #include "fdml_localization/core/util/text_parsing.h"
 #include "fdml_localization/simulation/map_generators.h"
 #include "fdml_localization/core/map/map_io.h"
+#include "fdml_localization/io/map_files.h"
 
 #include <cmath>
 #include <cstdio>
@@ -102,7 +103,7 @@ core::BenchScene mapScene(const std::string& spec)
   {
     stem = stem.substr(0, dot);
   }
-  core::PolygonMap map = core::loadPolyFile(path);
+  core::PolygonMap map = fdml_localization::io::loadMapFile(path);  // .poly or .yaml
   if (scale != 1.0)
   {
     map = map.scaled(scale);

@@ -133,6 +133,8 @@ std::vector<std::string> validate(const Params& p)
   check(&errors, knownName(p.engine, core::parseEngine), "engine", quoted(p.engine), "\"voxel\" or \"adaptive\"");
   check(&errors, knownName(p.method, core::parseMethod), "method", quoted(p.method),
         "\"robust\", \"paper\" or \"baseline\"");
+  check(&errors, knownName(p.no_return, core::parseNoReturn), "no_return", quoted(p.no_return),
+        "\"constraint\", \"weak\" or \"drop\"");
   check(&errors, p.localizer.min_inliers <= k, "min_inliers", p.localizer.min_inliers,
         "0 (automatic) or an integer in [3, ~measurements_per_batch]");
   // The core options: one validation, reported under the parameters' names (k is the batch size).
@@ -155,6 +157,10 @@ core::LocalizerOptions toLocalizerOptions(const Params& p)
   if (knownName(p.method, core::parseMethod))
   {
     options.method = core::parseMethod(p.method);
+  }
+  if (knownName(p.no_return, core::parseNoReturn))
+  {
+    options.no_return = core::parseNoReturn(p.no_return);
   }
   return options;
 }
@@ -229,8 +235,9 @@ std::string describe(const Params& p)
       << "  frames: global " << p.global_frame_id << ", odom " << p.odom_frame_id << ", base " << p.base_frame_id
       << "\n"
       << "  topics: range " << p.range_topic << ", scan " << p.scan_topic << "\n"
-      << "  engine: " << p.engine << ", method: " << p.method << ", resolution: " << p.localizer.resolution
-      << ", theta_resolution: " << p.localizer.theta_resolution << ", min_inliers: " << p.localizer.min_inliers << "\n"
+      << "  engine: " << p.engine << ", method: " << p.method << ", no_return: " << p.no_return
+      << ", resolution: " << p.localizer.resolution << ", theta_resolution: " << p.localizer.theta_resolution
+      << ", min_inliers: " << p.localizer.min_inliers << "\n"
       << "  agreement_tolerance: " << p.localizer.agreement_tolerance << " m"
       << (p.agreement_tolerance_set ? "" : " (default)") << ", uniqueness_distance: " << p.localizer.uniqueness_distance
       << " m, uniqueness_angle: " << p.localizer.uniqueness_angle
@@ -269,6 +276,7 @@ Params loadParams(const ros::NodeHandle& nh)
   nh.param("scan_topic", p.scan_topic, p.scan_topic);
   nh.param("engine", p.engine, p.engine);
   nh.param("method", p.method, p.method);
+  nh.param("no_return", p.no_return, p.no_return);
   nh.param("resolution", p.localizer.resolution, p.localizer.resolution);
   nh.param("theta_resolution", p.localizer.theta_resolution, p.localizer.theta_resolution);
   nh.param("min_inliers", p.localizer.min_inliers, p.localizer.min_inliers);

@@ -30,7 +30,8 @@ const char* kUsage = "usage: fdml_bench --map PATH[:SCALE] [--map ...] [--random
                      "                  --resolution 50,100,150,200 --trials 50 [--seed 1]\n"
                      "                  [--method robust|paper|baseline[,...]] [--engine voxel|adaptive] [--threads "
                      "J]\n"
-                     "                  [--moving-obstacles] [--translate] [--noise SIGMA]\n"
+                     "                  [--moving-obstacles] [--translate] [--noise SIGMA] [--no-return "
+                     "constraint|weak|drop]\n"
                      "                  [--csv FILE] [--markdown FILE]\n"
                      "Scene names: the map file's stem, random<VERTICES> for --random; a SCALE other than 1\n"
                      "appends _x<SCALE> (checkpoint.poly:0.25 -> checkpoint_x0.25, --random 70:2 -> random70_x2).\n";
@@ -219,6 +220,18 @@ Cli parseArgs(int argc, char** argv)
       catch (const std::invalid_argument&)
       {
         throw UsageError("--engine: '" + e + "' is not one of voxel, adaptive");
+      }
+    }
+    else if (flag == "--no-return")
+    {
+      const std::string v = value();
+      try
+      {
+        c.no_return = core::parseNoReturn(v);
+      }
+      catch (const std::invalid_argument&)
+      {
+        throw UsageError("--no-return: '" + v + "' is not one of constraint, weak, drop");
       }
     }
     else if (flag == "--threads")

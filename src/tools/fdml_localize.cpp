@@ -4,7 +4,7 @@
 //   fdml_localize --map MAP [--resolution N] [--min-inliers K|auto] [--method robust|paper|baseline]
 //                 [--range-tolerance T] [--tolerance EPS] [--threads J] [--engine voxel|adaptive]
 //                 [--cache-dir DIR] [--theta-resolution N] [--max-candidates M] [--max-range R]
-//                 [--verbose] READINGS.csv
+//                 [--verbose] [--no-return constraint|weak|drop] READINGS.csv
 //
 // READINGS.csv: header "gx,gy,gtheta,d" (optionally ",max_range"), one reading per line
 // [m, rad]; d may be "inf" (no return within max_range). Prints "rank,x,y,theta,inliers,rms"
@@ -42,6 +42,7 @@ const char* kUsage = "usage: fdml_localize --map MAP.poly|MAP.yaml [--resolution
                      "                     [--method robust|paper|baseline] [--range-tolerance T] [--tolerance EPS]\n"
                      "                     [--threads J] [--engine voxel|adaptive] [--cache-dir DIR]\n"
                      "                     [--theta-resolution N] [--max-candidates M] [--max-range R] [--verbose]\n"
+                     "                     [--no-return constraint|weak|drop]\n"
                      "                     READINGS.csv\n";
 
 std::vector<std::string> splitCsv(const std::string& line)
@@ -183,6 +184,10 @@ Arguments parseArguments(int argc, char** argv)
     else if (flag == "--engine")
     {
       args.options.engine = core::parseEngine(value());
+    }
+    else if (flag == "--no-return")
+    {
+      args.options.no_return = core::parseNoReturn(value());
     }
     else if (flag == "--range-tolerance")
     {

@@ -5,6 +5,9 @@
 #include "fdml_localization/core/map/grid/grid_to_polygon.h"
 #include "fdml_localization/core/geometry/ray_caster.h"
 
+#include "grid_test_maps.h"
+#include "localizer_test_utils.h"
+
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
@@ -17,16 +20,12 @@
 
 namespace core = fdml_localization::core;
 using core::Vec2;
+using grid_test::uniform;
 
 namespace
 {
 constexpr double kCell = 0.05;      // [m]
 constexpr double kMaxRange = 10.0;  // [m]
-
-double uniform(std::mt19937_64& rng)
-{
-  return static_cast<double>(rng() >> 11) * (1.0 / 9007199254740992.0);
-}
 
 core::Ring rotated(const core::Ring& ring, double angle, const Vec2& shift)
 {
@@ -62,30 +61,6 @@ std::vector<NamedMap> testMaps()
     { "L",
       core::PolygonMap::fromRings({ rotated(ell, -0.52, { 0.037, 3.6 }), rotated(column, -0.52, { 0.037, 3.6 }) }) },
   };
-}
-
-double distanceToWalls(const core::PolygonMap& map, const Vec2& p)
-{
-  double best = core::kInf;
-  for (const core::Segment& e : map.edges())
-  {
-    best = std::min(best, core::pointSegmentDistanceSquared(p, e));
-  }
-  return std::sqrt(best);
-}
-
-/// A uniformly random free pose at least @p clearance [m] from every wall.
-core::Pose2 freePose(const core::MapRayCaster& truth, double clearance, std::mt19937_64& rng)
-{
-  const core::Box2& b = truth.map().bounds();
-  while (true)
-  {
-    const Vec2 p(b.min.x() + uniform(rng) * b.size().x(), b.min.y() + uniform(rng) * b.size().y());
-    if (truth.isFree(p) && distanceToWalls(truth.map(), p) >= clearance)
-    {
-      return core::Pose2(p.x(), p.y(), core::kTwoPi * uniform(rng));
-    }
-  }
 }
 
 /// Hit and pass counts per cell of a grid covering @p map with a margin.
@@ -148,7 +123,7 @@ core::OccupancyGrid scanGrid(const core::MapRayCaster& truth, int poses, std::ui
   ScanGrid scans(truth.map(), kCell * uniform(rng));
   for (int k = 0; k < poses; ++k)
   {
-    const core::Pose2 pose = freePose(truth, 0.3, rng);
+    const core::Pose2 pose = core::test::randomFreePose(truth, rng, 0.3);
     for (int beam = 0; beam < 360; ++beam)
     {
       const double angle = pose.theta + core::kTwoPi * beam / 360.0;
@@ -180,7 +155,7 @@ ErrorStats rayErrors(const core::MapRayCaster& truth, const core::MapRayCaster& 
   ErrorStats stats;
   while (static_cast<int>(errors.size()) + stats.outliers < 4000)
   {
-    const core::Pose2 pose = freePose(truth, 0.2, rng);
+    const core::Pose2 pose = core::test::randomFreePose(truth, rng, 0.2);
     const Vec2 dir(std::cos(pose.theta), std::sin(pose.theta));
     const core::RayHit hit = truth.cast(pose.position(), dir, kMaxRange);
     if (!hit.hit())

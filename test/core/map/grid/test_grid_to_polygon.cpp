@@ -1,13 +1,14 @@
 // Occupancy grid -> polygon: exact tracing, validity under simplification, specks, seeds,
 // and ray casts on the converted polygon against an independent ray walk on the grid.
 #include "fdml_localization/core/map/grid/grid_to_polygon.h"
+
+#include "grid_test_maps.h"
 #include "fdml_localization/core/map/grid/grid_raster.h"
 #include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/core/geometry/ray_caster.h"
 #include "fdml_localization/io/map_files.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -20,39 +21,11 @@ namespace fs = std::filesystem;
 namespace core = fdml_localization::core;
 namespace io = fdml_localization::io;
 using core::Vec2;
+using grid_test::officeMap;
+using grid_test::uniform;
 
 namespace
 {
-double uniform(std::mt19937_64& rng)
-{
-  return static_cast<double>(rng() >> 11) * (1.0 / 9007199254740992.0);
-}
-
-/// A 12 x 8 m office: two wall stubs off the outer wall, a pillar, a desk block, a partition
-/// and a rotated square column.
-core::PolygonMap officeMap()
-{
-  std::vector<core::Ring> rings = {
-    { { 0, 0 },
-      { 12, 0 },
-      { 12, 8 },
-      { 7.1, 8 },
-      { 7.1, 5 },
-      { 6.9, 5 },
-      { 6.9, 8 },
-      { 0, 8 },
-      { 0, 4.1 },
-      { 3, 4.1 },
-      { 3, 3.9 },
-      { 0, 3.9 } },
-    { { 5, 1.5 }, { 5.3, 1.5 }, { 5.3, 1.8 }, { 5, 1.8 } },
-    { { 9, 2 }, { 11, 2 }, { 11, 3 }, { 9, 3 } },
-    { { 9, 5.5 }, { 9.2, 5.5 }, { 9.2, 7 }, { 9, 7 } },
-    { { 2, 6 }, { 2.4, 6.3 }, { 2, 6.6 }, { 1.6, 6.3 } },
-  };
-  return core::PolygonMap::fromRings(rings, "office");
-}
-
 std::vector<char> freeMask(const core::OccupancyGrid& g, int threshold = 50)
 {
   std::vector<char> free(g.cells.size());
@@ -434,94 +407,5 @@ TEST(GridToPolygon, RayCastsAgreeWithTheGridItself)
       EXPECT_GE(stats.within_two_cells, c.min_within_two) << label;
       EXPECT_LE(stats.median_cells, 0.1) << label;
     }
-  }
-}
-
-TEST(GridToPolygon, LoadMapFileDispatchesOnTheExtension)
-{
-  const fs::path dir = fs::temp_directory_path() / ("fdml_g2p_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  const core::PolygonMap office = officeMap();
-  core::savePolyFile((dir / "office.poly").string(), office);
-  io::saveOccupancyGridYaml((dir / "office.yaml").string(), core::rasterize(office, {}));
-  const core::PolygonMap from_poly = io::loadMapFile((dir / "office.poly").string());
-  const core::PolygonMap from_yaml = io::loadMapFile((dir / "office.yaml").string());
-  fs::remove_all(dir);
-  EXPECT_EQ(from_poly.hash(), office.hash());
-  EXPECT_EQ(from_yaml.holeCount(), office.holeCount());
-  // Rasterised by cell centres, converted with the walls through the wall cells (the default):
-  // the free space gains about 15/32 cell along every wall.
-  double perimeter = 0.0;
-  for (const core::Segment& e : office.edges())
-  {
-    perimeter += (e.b - e.a).norm();
-  }
-  EXPECT_NEAR(from_yaml.area(), office.area() + 15.0 / 32.0 * 0.05 * perimeter, 0.5);
-}
-
-TEST(ShippedGrids, AreReproducibleFromTheirPolygonsAndConvertBack)
-{
-  struct Shipped
-  {
-    const char* name;
-    double noise;
-    int specks;
-    int islands;
-    std::uint64_t seed;
-  };
-  // The commands in docs/maps_occupancy.md.
-  const Shipped maps[] = { { "office", 0.1, 40, 12, 7 }, { "apartment", 0.05, 20, 6, 3 } };
-  for (const Shipped& m : maps)
-  {
-    const std::string base = std::string(FDML_SOURCE_DIR) + "/maps/" + m.name;
-    const core::PolygonMap original = core::loadPolyFile(base + ".poly");
-    core::RasterizeOptions raster;
-    raster.boundary_noise = m.noise;
-    raster.specks = m.specks;
-    raster.islands = m.islands;
-    raster.seed = m.seed;
-    const core::OccupancyGrid made = core::rasterize(original, raster);
-    const core::OccupancyGrid shipped = io::loadOccupancyGridYaml(base + "_grid.yaml");
-    EXPECT_EQ(shipped.width, made.width) << m.name;
-    EXPECT_EQ(shipped.height, made.height) << m.name;
-    EXPECT_EQ(shipped.cells, made.cells) << m.name;
-    EXPECT_NEAR(shipped.origin.x, made.origin.x, 1e-12) << m.name;
-
-    core::GridConversionReport report;
-    const core::PolygonMap converted = core::gridToPolygon(shipped, {}, m.name, &report);
-    EXPECT_EQ(converted.holeCount(), original.holeCount()) << m.name;
-    EXPECT_EQ(report.holes_dropped, m.specks) << m.name;
-    EXPECT_EQ(report.regions, 1 + m.islands) << m.name;
-    double perimeter = 0.0;
-    for (const core::Segment& e : original.edges())
-    {
-      perimeter += (e.b - e.a).norm();
-    }
-    EXPECT_LT(std::abs(converted.area() - original.area()), 0.5 * perimeter * shipped.resolution) << m.name;
-
-    // Ray casts on the converted map against the original polygon (the ground truth).
-    const core::MapRayCaster truth(original);
-    const core::MapRayCaster conv(converted);
-    std::mt19937_64 rng(m.seed);
-    int rays = 0;
-    int within_one = 0;
-    int within_two = 0;
-    while (rays < 2000)
-    {
-      const Vec2 p(original.bounds().min.x() + uniform(rng) * original.bounds().size().x(),
-                   original.bounds().min.y() + uniform(rng) * original.bounds().size().y());
-      if (!truth.isFree(p))
-      {
-        continue;
-      }
-      const core::Pose2 sensor(p.x(), p.y(), core::kTwoPi * uniform(rng));
-      const double error = std::abs(truth.range(sensor) - conv.range(sensor)) / shipped.resolution;
-      ++rays;
-      within_one += error <= 1.0;
-      within_two += error <= 2.0;
-    }
-    // Measured: office 89.7 % / 97.3 %, apartment 94.6 % / 98.7 % (wall noise seen at grazing angles).
-    EXPECT_GE(within_one, 0.85 * rays) << m.name;
-    EXPECT_GE(within_two, 0.95 * rays) << m.name;
   }
 }

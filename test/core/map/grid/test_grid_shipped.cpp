@@ -1,5 +1,5 @@
-// The one map loader on both file types, and the shipped grids: reproducible from their
-// polygons by the rasteriser, and converted back close to the original walls.
+// The seed point's choice of region, the one map loader on both file types, and the shipped
+// grids: reproducible from their polygons by the rasteriser, converted back close to the walls.
 #include "fdml_localization/core/geometry/ray_caster.h"
 #include "fdml_localization/core/map/grid/grid_raster.h"
 #include "fdml_localization/core/map/grid/grid_to_polygon.h"
@@ -73,6 +73,31 @@ std::pair<double, double> raysWithinCells(const core::PolygonMap& original, cons
   return { within_one / 2000.0, within_two / 2000.0 };
 }
 }  // namespace
+
+TEST(GridToPolygon, SeedPointPicksItsOwnRoom)
+{
+  core::OccupancyGrid g;
+  g.width = 30;
+  g.height = 10;
+  g.resolution = 0.2;
+  g.cells.assign(300, 100);
+  for (int iy = 1; iy < 9; ++iy)
+  {
+    for (int ix = 1; ix < 29; ++ix)
+    {
+      g.at(ix, iy) = (ix == 20) ? 100 : 0;  // a big room (x < 20) and a small one
+    }
+  }
+  core::GridConversionOptions options;
+  options.walls = core::GridWalls::CellEdges;
+  options.tolerance = 1e-9;
+  const double big = core::gridToPolygon(g, options).area();
+  options.use_seed = true;
+  options.seed_point = Vec2(4.5, 1.0);  // cell (22, 5): the small room
+  const double small = core::gridToPolygon(g, options).area();
+  EXPECT_NEAR(big, 19 * 8 * 0.04, 1e-9);
+  EXPECT_NEAR(small, 8 * 8 * 0.04, 1e-9);
+}
 
 TEST(GridToPolygon, LoadMapFileDispatchesOnTheExtension)
 {

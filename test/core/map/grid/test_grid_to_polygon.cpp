@@ -341,29 +341,6 @@ TEST(GridToPolygon, SpecksAndIslandsAreDroppedAndRoomsKept)
   EXPECT_GT(map.area(), office.area() - perimeter * raster.resolution);
 }
 
-TEST(GridToPolygon, SeedPointPicksItsOwnRoom)
-{
-  core::OccupancyGrid g;
-  g.width = 30;
-  g.height = 10;
-  g.resolution = 0.2;
-  g.cells.assign(300, 100);
-  for (int iy = 1; iy < 9; ++iy)
-  {
-    for (int ix = 1; ix < 29; ++ix)
-    {
-      g.at(ix, iy) = (ix == 20) ? 100 : 0;  // a big room (x < 20) and a small one
-    }
-  }
-  core::GridConversionOptions options = exact();
-  const double big = core::gridToPolygon(g, options).area();
-  options.use_seed = true;
-  options.seed_point = Vec2(4.5, 1.0);  // cell (22, 5): the small room
-  const double small = core::gridToPolygon(g, options).area();
-  EXPECT_NEAR(big, 19 * 8 * 0.04, 1e-9);
-  EXPECT_NEAR(small, 8 * 8 * 0.04, 1e-9);
-}
-
 TEST(GridToPolygon, RayCastsAgreeWithTheGridItself)
 {
   // With the walls on the cell edges and unsimplified, a ray meets the polygon where it meets

@@ -82,11 +82,16 @@ void checkOptions(const GridConversionOptions& options, const std::string& sourc
     throw MapError(source, 0,
                    "occupied_threshold must be in [1, 100] (got " + std::to_string(options.occupied_threshold) + ")");
   }
+  if (options.walls != GridWalls::Measured && options.walls != GridWalls::CellEdges)
+  {
+    throw MapError(source, 0, "conversion walls must be measured or cell_edges");
+  }
   if (options.use_seed && !(std::isfinite(options.seed_point.x()) && std::isfinite(options.seed_point.y())))
   {
     throw MapError(source, 0, "seed point must be finite");
   }
 }
+
 /// The free mask (counted into @p info) and the free region to keep (its label's cells).
 std::vector<char> chooseRegion(const OccupancyGrid& grid, const GridConversionOptions& options,
                                const std::string& source, GridConversionReport* info)

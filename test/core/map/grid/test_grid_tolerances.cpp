@@ -2,6 +2,7 @@
 // loader (readMapFile) reporting the cell size of a grid map or of a .poly converted from one.
 #include "fdml_localization/core/map/grid/grid_tolerances.h"
 #include "fdml_localization/core/map/grid/grid_raster.h"
+#include "fdml_localization/core/map/grid/grid_to_polygon.h"
 #include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/io/map_files.h"
 
@@ -118,4 +119,15 @@ TEST(GridTolerances, ReadMapFileReportsTheGridOfAYaml)
   core::GridConversionReport report;
   EXPECT_EQ(io::loadMapFile(dir.file("room.yaml"), {}, &report).hash(), file.map.hash());
   EXPECT_EQ(report.vertices_kept, file.report.vertices_kept);
+}
+
+TEST(GridWallsOption, NamesParseAndBadValuesAreRefused)
+{
+  EXPECT_EQ(core::parseGridWalls("measured"), core::GridWalls::Measured);
+  EXPECT_EQ(core::parseGridWalls(core::toString(core::GridWalls::CellEdges)), core::GridWalls::CellEdges);
+  EXPECT_THROW(core::parseGridWalls("centres"), std::invalid_argument);
+  core::GridConversionOptions options;
+  options.walls = static_cast<core::GridWalls>(5);
+  core::RasterizeOptions raster;
+  EXPECT_THROW(core::gridToPolygon(core::rasterize(room(), raster), options, "grid"), core::MapError);
 }

@@ -112,6 +112,7 @@ LocalizerOptions benchLocalizerOptions(const BenchConfig& config, Method method,
 {
   LocalizerOptions o;
   o.engine = config.engine;
+  o.no_return = config.no_return;
   o.method = method;
   o.resolution = n;
   o.threads = config.threads;

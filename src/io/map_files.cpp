@@ -1,6 +1,7 @@
 #include "fdml_localization/io/map_files.h"
 
 #include "fdml_localization/core/map/grid/grid_to_polygon.h"
+#include "fdml_localization/core/map/grid/grid_tolerances.h"
 #include "fdml_localization/core/map/map_io.h"
 
 #include <stb/stb_image.h>
@@ -30,6 +31,7 @@ using core::parseMapMode;
 using core::pixelsToGrid;
 using core::PolygonMap;
 using core::Pose2;
+using core::readPolyCellSize;
 
 namespace
 {
@@ -263,21 +265,37 @@ void saveOccupancyGridYaml(const std::string& yaml_path, const OccupancyGrid& gr
   }
 }
 
-PolygonMap loadMapFile(const std::string& path, const GridConversionOptions& options, GridConversionReport* report)
+MapFile readMapFile(const std::string& path, const GridConversionOptions& options)
 {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  MapFile file;
   if (ext == ".poly")
   {
-    return loadPolyFile(path);
+    file.map = loadPolyFile(path);
+    file.cell_size = readPolyCellSize(path);
+    return file;
   }
   if (ext == ".yaml" || ext == ".yml")
   {
-    return gridToPolygon(loadOccupancyGridYaml(path), options, path, report);
+    file.grid = loadOccupancyGridYaml(path);
+    file.map = gridToPolygon(file.grid, options, path, &file.report);
+    file.cell_size = file.grid.resolution;
+    return file;
   }
   throw MapError(path, 0,
                  "unknown map file type '" + ext +
                      "' (allowed: .poly polygon files, .yaml/.yml map_server occupancy grids)");
+}
+
+PolygonMap loadMapFile(const std::string& path, const GridConversionOptions& options, GridConversionReport* report)
+{
+  MapFile file = readMapFile(path, options);
+  if (report != nullptr)
+  {
+    *report = file.report;
+  }
+  return std::move(file.map);
 }
 
 }  // namespace io

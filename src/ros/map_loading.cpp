@@ -3,23 +3,12 @@
 #include "fdml_localization/ros/param_utils.h"
 #include "fdml_localization/io/map_files.h"
 
-#include <algorithm>
-#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 
 namespace fdml_localization
 {
-namespace
-{
-bool isYamlPath(const std::string& path)
-{
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  return ext == ".yaml" || ext == ".yml";
-}
-}  // namespace
 
 std::string resolveMapPath(const std::string& location)
 {
@@ -74,17 +63,15 @@ LoadedMap loadMapFromFile(const std::string& location, const core::GridConversio
   }
   try
   {
-    if (isYamlPath(path))
-    {
-      // The grid's resolution is needed for the tolerances (withGridTolerances()): load it here,
-      // then convert as io::loadMapFile() does.
-      LoadedMap loaded = mapFromGrid(io::loadOccupancyGridYaml(path), options, path);
-      loaded.summary = path + ": " + loaded.summary;
-      return loaded;
-    }
+    io::MapFile file = io::readMapFile(path, options);
     LoadedMap loaded;
     loaded.source = path;
-    loaded.map = std::make_shared<const core::MapRayCaster>(io::loadMapFile(path, options));
+    loaded.grid_resolution = file.cell_size;
+    if (!file.grid.empty())
+    {
+      loaded.summary = path + ": " + describeConversion(file.grid, file.report);
+    }
+    loaded.map = std::make_shared<const core::MapRayCaster>(std::move(file.map));
     return loaded;
   }
   catch (const std::exception& error)

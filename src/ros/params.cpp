@@ -2,6 +2,7 @@
 
 #include "fdml_localization/ros/param_utils.h"
 #include "fdml_localization/ros/reading_buffer.h"
+#include "fdml_localization/core/map/grid/grid_tolerances.h"
 
 #include <ros/node_handle.h>
 
@@ -148,6 +149,8 @@ void validateCoreParams(const Params& p, std::vector<std::string>* errors)
   check(errors, knownName(p.engine, core::parseEngine), "engine", quoted(p.engine), "\"voxel\" or \"adaptive\"");
   check(errors, knownName(p.method, core::parseMethod), "method", quoted(p.method),
         "\"robust\", \"paper\" or \"baseline\"");
+  check(errors, knownName(p.no_return, core::parseNoReturn), "no_return", quoted(p.no_return),
+        "\"constraint\", \"weak\" or \"drop\"");
   check(errors, p.localizer.min_inliers <= p.measurements_per_batch, "min_inliers", p.localizer.min_inliers,
         "0 (automatic) or an integer in [3, ~measurements_per_batch]");
   // The core options: one validation, reported under the parameters' names (k is the batch size).
@@ -181,6 +184,10 @@ core::LocalizerOptions toLocalizerOptions(const Params& p)
   {
     options.method = core::parseMethod(p.method);
   }
+  if (knownName(p.no_return, core::parseNoReturn))
+  {
+    options.no_return = core::parseNoReturn(p.no_return);
+  }
   return options;
 }
 
@@ -201,18 +208,8 @@ core::GridConversionOptions toGridOptions(const Params& p)
 Params withGridTolerances(const Params& params, double resolution)
 {
   Params p = params;
-  if (!(resolution > 0.0) || !std::isfinite(resolution))
-  {
-    return p;
-  }
-  if (!p.range_tolerance_set)
-  {
-    p.localizer.range_tolerance = std::max(p.localizer.range_tolerance, resolution);
-  }
-  if (!p.agreement_tolerance_set)
-  {
-    p.localizer.agreement_tolerance = std::max(p.localizer.agreement_tolerance, 2.0 * resolution);
-  }
+  p.localizer = core::withGridTolerances(params.localizer, resolution,
+                                         { params.range_tolerance_set, params.agreement_tolerance_set });
   return p;
 }
 
@@ -264,8 +261,9 @@ std::string describe(const Params& p)
       << "  frames: global " << p.global_frame_id << ", odom " << p.odom_frame_id << ", base " << p.base_frame_id
       << "\n"
       << "  topics: range " << p.range_topic << ", scan " << p.scan_topic << "\n"
-      << "  engine: " << p.engine << ", method: " << p.method << ", resolution: " << p.localizer.resolution
-      << ", theta_resolution: " << p.localizer.theta_resolution << ", min_inliers: " << p.localizer.min_inliers << "\n"
+      << "  engine: " << p.engine << ", method: " << p.method << ", no_return: " << p.no_return
+      << ", resolution: " << p.localizer.resolution << ", theta_resolution: " << p.localizer.theta_resolution
+      << ", min_inliers: " << p.localizer.min_inliers << "\n"
       << "  agreement_tolerance: " << p.localizer.agreement_tolerance << " m"
       << (p.agreement_tolerance_set ? "" : " (default)") << ", uniqueness_distance: " << p.localizer.uniqueness_distance
       << " m, uniqueness_angle: " << p.localizer.uniqueness_angle
@@ -319,6 +317,7 @@ void readCoreParams(ParamReader& r, Params* p)
   core::LocalizerOptions& o = p->localizer;
   r.read("engine", &p->engine);
   r.read("method", &p->method);
+  r.read("no_return", &p->no_return);
   r.read("resolution", &o.resolution);
   r.read("theta_resolution", &o.theta_resolution);
   r.read("min_inliers", &o.min_inliers);

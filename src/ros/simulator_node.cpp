@@ -3,6 +3,7 @@
 #include "fdml_localization/ReadingTruth.h"
 #include "fdml_localization/core/map/grid/grid_raster.h"
 #include "fdml_localization/core/map/map_io.h"
+#include "fdml_localization/io/map_files.h"
 #include "fdml_localization/ros/conversions.h"
 #include "fdml_localization/ros/markers.h"
 #include "fdml_localization/ros/param_utils.h"
@@ -104,7 +105,7 @@ bool SimulatorNode::loadScenario(std::vector<std::string>* errors)
   }
   try
   {
-    map_ = std::make_shared<core::MapRayCaster>(core::loadPolyFile(map_path_));
+    map_ = std::make_shared<core::MapRayCaster>(io::loadMapFile(map_path_));  // .poly or .yaml
   }
   catch (const std::exception& e)
   {

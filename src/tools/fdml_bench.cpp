@@ -4,6 +4,7 @@
 #include "fdml_localization/core/util/text_parsing.h"
 #include "fdml_localization/simulation/map_generators.h"
 #include "fdml_localization/core/map/map_io.h"
+#include "fdml_localization/io/map_files.h"
 
 #include <cmath>
 #include <cstdio>
@@ -29,7 +30,8 @@ const char* kUsage = "usage: fdml_bench --map PATH[:SCALE] [--map ...] [--random
                      "                  --resolution 50,100,150,200 --trials 50 [--seed 1]\n"
                      "                  [--method robust|paper|baseline[,...]] [--engine voxel|adaptive] [--threads "
                      "J]\n"
-                     "                  [--moving-obstacles] [--translate] [--noise SIGMA]\n"
+                     "                  [--moving-obstacles] [--translate] [--noise SIGMA] [--no-return "
+                     "constraint|weak|drop]\n"
                      "                  [--csv FILE] [--markdown FILE]\n"
                      "Scene names: the map file's stem, random<VERTICES> for --random; a SCALE other than 1\n"
                      "appends _x<SCALE> (checkpoint.poly:0.25 -> checkpoint_x0.25, --random 70:2 -> random70_x2).\n";
@@ -102,7 +104,7 @@ core::BenchScene mapScene(const std::string& spec)
   {
     stem = stem.substr(0, dot);
   }
-  core::PolygonMap map = core::loadPolyFile(path);
+  core::PolygonMap map = fdml_localization::io::loadMapFile(path);  // .poly or .yaml
   if (scale != 1.0)
   {
     map = map.scaled(scale);
@@ -218,6 +220,18 @@ Cli parseArgs(int argc, char** argv)
       catch (const std::invalid_argument&)
       {
         throw UsageError("--engine: '" + e + "' is not one of voxel, adaptive");
+      }
+    }
+    else if (flag == "--no-return")
+    {
+      const std::string v = value();
+      try
+      {
+        c.no_return = core::parseNoReturn(v);
+      }
+      catch (const std::invalid_argument&)
+      {
+        throw UsageError("--no-return: '" + v + "' is not one of constraint, weak, drop");
       }
     }
     else if (flag == "--threads")

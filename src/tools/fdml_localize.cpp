@@ -1,17 +1,20 @@
-// fdml_localize: global localization from a CSV of range readings on a .poly map.
+// fdml_localize: global localization from a CSV of range readings on a map (.poly, or a
+// map_server .yaml grid; a map from a grid gets the grid tolerances, core::withGridTolerances).
 //
 //   fdml_localize --map MAP [--resolution N] [--min-inliers K|auto] [--method robust|paper|baseline]
 //                 [--range-tolerance T] [--tolerance EPS] [--threads J] [--engine voxel|adaptive]
 //                 [--cache-dir DIR] [--theta-resolution N] [--max-candidates M] [--max-range R]
-//                 [--verbose] READINGS.csv
+//                 [--verbose] [--no-return constraint|weak|drop] READINGS.csv
 //
 // READINGS.csv: header "gx,gy,gtheta,d" (optionally ",max_range"), one reading per line
 // [m, rad]; d may be "inf" (no return within max_range). Prints "rank,x,y,theta,inliers,rms"
 // and one candidate per line, best first; exit 0 (also with no candidate), 2 on bad input.
 #include "fdml_localization/core/localization/localizer.h"
+#include "fdml_localization/core/map/grid/grid_tolerances.h"
 #include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/core/localization/ranking.h"
 #include "fdml_localization/core/util/text_parsing.h"
+#include "fdml_localization/io/map_files.h"
 
 #include <cerrno>
 #include <cmath>
@@ -27,6 +30,7 @@
 namespace
 {
 namespace core = fdml_localization::core;
+namespace io = fdml_localization::io;
 
 /// Bad input: reported on stderr, exit code 2.
 struct UsageError : std::runtime_error
@@ -34,10 +38,11 @@ struct UsageError : std::runtime_error
   using std::runtime_error::runtime_error;
 };
 
-const char* kUsage = "usage: fdml_localize --map MAP [--resolution N] [--min-inliers K|auto]\n"
+const char* kUsage = "usage: fdml_localize --map MAP.poly|MAP.yaml [--resolution N] [--min-inliers K|auto]\n"
                      "                     [--method robust|paper|baseline] [--range-tolerance T] [--tolerance EPS]\n"
                      "                     [--threads J] [--engine voxel|adaptive] [--cache-dir DIR]\n"
                      "                     [--theta-resolution N] [--max-candidates M] [--max-range R] [--verbose]\n"
+                     "                     [--no-return constraint|weak|drop]\n"
                      "                     READINGS.csv\n";
 
 std::vector<std::string> splitCsv(const std::string& line)
@@ -135,6 +140,7 @@ struct Arguments
   core::LocalizerOptions options;
   double max_range = core::kInf;
   bool verbose = false;
+  core::ExplicitTolerances set;  ///< tolerances given on the command line (kept on a grid map)
 };
 
 Arguments parseArguments(int argc, char** argv)
@@ -179,13 +185,19 @@ Arguments parseArguments(int argc, char** argv)
     {
       args.options.engine = core::parseEngine(value());
     }
+    else if (flag == "--no-return")
+    {
+      args.options.no_return = core::parseNoReturn(value());
+    }
     else if (flag == "--range-tolerance")
     {
       args.options.range_tolerance = core::parseNumber(value(), flag);
+      args.set.range_tolerance = true;
     }
     else if (flag == "--tolerance")
     {
       args.options.agreement_tolerance = core::parseNumber(value(), flag);
+      args.set.agreement_tolerance = true;
     }
     else if (flag == "--threads")
     {
@@ -295,8 +307,9 @@ int main(int argc, char** argv)
       throw UsageError(text);
     }
     const std::vector<core::Reading> readings = readCsv(args.csv, args.max_range);
-    auto map = std::make_shared<const core::MapRayCaster>(core::loadPolyFile(args.map));
-    core::Localizer localizer(map, args.options);
+    io::MapFile file = io::readMapFile(args.map);
+    auto map = std::make_shared<const core::MapRayCaster>(std::move(file.map));
+    core::Localizer localizer(map, core::withGridTolerances(args.options, file.cell_size, args.set));
     const core::Result result = localizer.localize(readings);
     printResult(result);
     if (args.verbose)

@@ -9,6 +9,7 @@
  */
 #include "fdml_localization/core/map/grid/grid_to_polygon.h"
 #include "fdml_localization/core/util/text_parsing.h"
+#include "fdml_localization/core/map/grid/grid_tolerances.h"
 #include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/io/map_files.h"
 
@@ -155,7 +156,8 @@ int main(int argc, char** argv)
     return 2;
   }
   std::ostringstream comment;
-  comment << "converted from " << std::filesystem::path(args.input).filename().string() << " by fdml_map_convert"
+  comment << core::cellSizeHeader(grid.resolution) << "\n"  // read back for the grid tolerances
+          << "converted from " << std::filesystem::path(args.input).filename().string() << " by fdml_map_convert"
           << " (tolerance " << report.tolerance_used << " m, min area " << report.min_area_used << " m^2)";
   const std::string png = std::filesystem::path(args.output).replace_extension(".png").string();
   try

@@ -35,6 +35,8 @@ struct BenchConfig
   std::uint64_t seed = 1;
   std::vector<Method> methods{ Method::Robust };
   Engine engine = Engine::Voxel;
+  /// LocalizerOptions::no_return
+  NoReturnPolicy no_return = NoReturnPolicy::Constraint;
   int min_inliers = 6;       ///< k'; 0 = automatic (robust only)
   int threads = 0;           ///< localizer threads; 0 = all cores
   ProtocolOptions protocol;  ///< protocol.obstacles is set per m

@@ -41,11 +41,27 @@ void writePgm(const std::string& path, const core::OccupancyGrid& grid);
  */
 void saveOccupancyGridYaml(const std::string& yaml_path, const core::OccupancyGrid& grid);
 
+/// A map file as readMapFile() loads it.
+struct MapFile
+{
+  core::PolygonMap map;
+  /// Cell size [m] of the occupancy grid the map comes from (a map_server YAML, or a `.poly`
+  /// whose header records it: core::cellSizeHeader()); 0 for a plain polygon map. Give it to
+  /// core::withGridTolerances().
+  double cell_size = 0.0;
+  core::OccupancyGrid grid;           ///< the grid read (a YAML only; empty otherwise)
+  core::GridConversionReport report;  ///< what its conversion did (a YAML only)
+};
+
 /**
- * @brief Loads any map file: `.poly` (loadPolyFile) or a map_server `.yaml` / `.yml`
- *        (loadOccupancyGridYaml, then gridToPolygon with @p options).
+ * @brief Loads any map file, the one loader every tool and node uses: `.poly` (loadPolyFile,
+ *        plus its cell-size header) or a map_server `.yaml` / `.yml` (loadOccupancyGridYaml,
+ *        then gridToPolygon with @p options).
  * @throws core::MapError naming the file and the problem (also for an unknown extension).
  */
+MapFile readMapFile(const std::string& path, const core::GridConversionOptions& options = {});
+
+/// readMapFile(), the map only (@p report, when not null, receives the conversion's report).
 core::PolygonMap loadMapFile(const std::string& path, const core::GridConversionOptions& options = {},
                              core::GridConversionReport* report = nullptr);
 

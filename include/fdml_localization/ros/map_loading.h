@@ -26,7 +26,8 @@ struct LoadedMap
 {
   std::shared_ptr<const core::MapRayCaster> map;  ///< null when there is no map (yet)
   std::string source;                             ///< the file or topic it came from
-  /// Cell size [m] of the occupancy grid the map was converted from; 0 for a polygon file.
+  /// Cell size [m] of the occupancy grid the map comes from (a grid, or a `.poly` whose header
+  /// records it); 0 for a plain polygon file. Tolerances: core::withGridTolerances().
   double grid_resolution = 0.0;
   /// One-line summary of the grid conversion (empty for a polygon file).
   std::string summary;
@@ -41,7 +42,7 @@ struct LoadedMap
 std::string resolveMapPath(const std::string& location);
 
 /**
- * @brief Loads the map named by @p location (see resolveMapPath()) with io::loadMapFile():
+ * @brief Loads the map named by @p location (see resolveMapPath()) with io::readMapFile():
  *        a `.poly` file, or a map_server `.yaml` / `.yml` converted with @p options.
  * @throws MapLoadError naming ~map_file, the file (the image for a missing image), the line
  *         when known, and the problem.

@@ -75,6 +75,7 @@ struct Params
   // names are kept as text here, so that an unknown name can be reported.
   std::string engine = "voxel";          ///< ~engine: voxel | adaptive
   std::string method = "robust";         ///< ~method: robust | paper | baseline
+  std::string no_return = "constraint";  ///< ~no_return: constraint | weak | drop (core NoReturnPolicy)
   core::LocalizerOptions localizer;      ///< every other core option (engine, method: see above)
   bool agreement_tolerance_set = false;  ///< the user set ~agreement_tolerance (see withGridTolerances())
   bool range_tolerance_set = false;      ///< the user set ~range_tolerance (see withGridTolerances())

@@ -2,6 +2,7 @@
 
 #include "fdml_localization/core/geometry/cone_cast.h"
 #include "fdml_localization/core/localization/adaptive/adaptive_engine.h"
+#include "fdml_localization/core/localization/no_return.h"
 
 #include "fdml_localization/core/localization/voxel/voxel_engine.h"
 
@@ -118,6 +119,9 @@ std::vector<std::string> validate(const LocalizerOptions& o, const std::function
         "0 (all cores) or an integer in [1, 1024]");
   check(o.max_boxes >= 1000, "max_boxes", std::to_string(o.max_boxes), "an integer >= 1000");
   check(in(o.deadline, 0.0, 3600.0), "deadline", number(o.deadline), "0 (none) or (0, 3600] s");
+  check(o.no_return == NoReturnPolicy::Constraint || o.no_return == NoReturnPolicy::Weak ||
+            o.no_return == NoReturnPolicy::Drop,
+        "no_return", std::to_string(static_cast<int>(o.no_return)), "constraint, weak or drop");
   return errors;
 }
 
@@ -210,7 +214,15 @@ void Localizer::prepare()
 Result Localizer::localize(const std::vector<Reading>& readings)
 {
   validateReadings(readings, options_);
-  return engine_->localize(readings);
+  if (options_.no_return == NoReturnPolicy::Constraint)
+  {
+    return engine_->localize(readings);
+  }
+  std::vector<std::size_t> kept;
+  const std::vector<Reading> returns = readingsWithReturn(readings, options_, &kept);
+  Result result = engine_->localize(returns);
+  restoreNoReturns(&result, readings, kept, options_, *map_);
+  return result;
 }
 
 }  // namespace core

@@ -51,8 +51,19 @@ enum class Engine
   Adaptive  ///< branch and prune over boxes of poses
 };
 
+/// How readings with no return (range = +inf) are used; see no_return.h.
+enum class NoReturnPolicy
+{
+  Constraint,  ///< agrees only where the map has no wall within max_range (a ToF sensor: no return = free)
+  Weak,        ///< never an inlier nor contradicted; orders candidates tied otherwise (a lidar)
+  Drop         ///< removed before the search (at least 3 readings with a return are needed)
+};
+
 const char* toString(Method method);
 const char* toString(Engine engine);
+const char* toString(NoReturnPolicy policy);
+/// Parses "constraint" / "weak" / "drop"; throws std::invalid_argument otherwise.
+NoReturnPolicy parseNoReturn(const std::string& text);
 /// Parses "robust" / "paper" / "baseline"; throws std::invalid_argument otherwise.
 Method parseMethod(const std::string& text);
 /// Parses "voxel" / "adaptive"; throws std::invalid_argument otherwise.
@@ -85,6 +96,8 @@ struct LocalizerOptions
   // Adaptive engine budget.
   long max_boxes = 20000000;  ///< stop subdividing after this many boxes (>= 1000)
   double deadline = 0.0;      ///< wall-time budget per call [s]; 0 = none
+  /// Readings with no return: constraints (the default), weak evidence, or dropped.
+  NoReturnPolicy no_return = NoReturnPolicy::Constraint;
 };
 
 /**

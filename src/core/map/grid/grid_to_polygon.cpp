@@ -1,14 +1,14 @@
 #include "fdml_localization/core/map/grid/grid_to_polygon.h"
 
+#include "fdml_localization/core/map/grid/grid_trace.h"
+
 #include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/core/map/ring_simplify.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
-#include <cstdint>
-#include <filesystem>
 #include <sstream>
+#include <stdexcept>
 
 namespace fdml_localization
 {
@@ -67,95 +67,6 @@ int labelRegions(const std::vector<char>& free, int width, int height, std::vect
   return static_cast<int>(sizes->size());
 }
 
-/**
- * Traces the boundary of the region along the cell edges, region on the left, so straight
- * walls lie exactly on the cell edges. At a vertex where the region touches itself only
- * diagonally (a saddle), the trace turns tightly around each cell, so the region stays
- * 4-connected and the walls 8-connected, and cuts a tiny chamfer (kChamfer cells) off each
- * of the two region corners there, so that no ring touches itself or another.
- * Returns rings in local cell units: cell (ix, iy) spans [ix, ix + 1] x [iy, iy + 1].
- */
-std::vector<Ring> traceBoundaries(const std::vector<char>& region, int width, int height)
-{
-  constexpr double kChamfer = 0.125;  // exact in binary: keeps cell-unit arithmetic exact
-  // Side s of a cell runs from its corner s to corner s + 1 (counter-clockwise: bottom, right,
-  // top, left); kDir[s] is its direction and kDir[s + 1] the inward normal (the region side).
-  static const int kDir[4][2] = { { 1, 0 }, { 0, 1 }, { -1, 0 }, { 0, -1 } };
-  static const int kCorner[4][2] = { { 0, 0 }, { 1, 0 }, { 1, 1 }, { 0, 1 } };
-  auto in = [&](int x, int y) {
-    return x >= 0 && y >= 0 && x < width && y < height && region[static_cast<std::size_t>(y) * width + x];
-  };
-  auto isBoundary = [&](int x, int y, int s) {
-    const int* n = kDir[(s + 1) % 4];
-    return in(x, y) && !in(x - n[0], y - n[1]);
-  };
-  std::vector<std::uint8_t> visited(region.size(), 0);  // one bit per side
-  std::vector<Ring> rings;
-  for (int y0 = 0; y0 < height; ++y0)
-  {
-    for (int x0 = 0; x0 < width; ++x0)
-    {
-      for (int s0 = 0; s0 < 4; ++s0)
-      {
-        const std::size_t c0 = static_cast<std::size_t>(y0) * width + x0;
-        if (!isBoundary(x0, y0, s0) || (visited[c0] & (1u << s0)))
-        {
-          continue;
-        }
-        Ring ring;
-        int x = x0;
-        int y = y0;
-        int s = s0;
-        do
-        {
-          visited[static_cast<std::size_t>(y) * width + x] |= static_cast<std::uint8_t>(1u << s);
-          const int* d = kDir[s];
-          const int* n = kDir[(s + 1) % 4];
-          const Vec2 v(x + kCorner[(s + 1) % 4][0], y + kCorner[(s + 1) % 4][1]);
-          if (!in(x + d[0], y + d[1]))
-          {
-            // Left turn around the same cell; a saddle when the diagonal cell is region too.
-            if (in(x + d[0] - n[0], y + d[1] - n[1]))
-            {
-              ring.push_back(v - kChamfer * Vec2(d[0], d[1]));
-              ring.push_back(v + kChamfer * Vec2(n[0], n[1]));
-            }
-            else
-            {
-              ring.push_back(v);
-            }
-            s = (s + 1) % 4;
-          }
-          else if (!in(x + d[0] - n[0], y + d[1] - n[1]))
-          {
-            x += d[0];  // straight on along the next cell's same side
-            y += d[1];
-          }
-          else
-          {
-            ring.push_back(v);  // right turn onto the diagonal cell
-            x += d[0] - n[0];
-            y += d[1] - n[1];
-            s = (s + 3) % 4;
-          }
-        } while (!(x == x0 && y == y0 && s == s0));
-        rings.push_back(std::move(ring));
-      }
-    }
-  }
-  return rings;
-}
-
-double ringAreaCells(const Ring& ring)
-{
-  double sum = 0.0;
-  for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++)
-  {
-    sum += ring[j].x() * ring[i].y() - ring[i].x() * ring[j].y();
-  }
-  return 0.5 * sum;
-}
-
 void checkOptions(const GridConversionOptions& options, const std::string& source)
 {
   if (!std::isfinite(options.tolerance))
@@ -171,46 +82,36 @@ void checkOptions(const GridConversionOptions& options, const std::string& sourc
     throw MapError(source, 0,
                    "occupied_threshold must be in [1, 100] (got " + std::to_string(options.occupied_threshold) + ")");
   }
+  if (options.walls != GridWalls::Measured && options.walls != GridWalls::CellEdges)
+  {
+    throw MapError(source, 0, "conversion walls must be measured or cell_edges");
+  }
   if (options.use_seed && !(std::isfinite(options.seed_point.x()) && std::isfinite(options.seed_point.y())))
   {
     throw MapError(source, 0, "seed point must be finite");
   }
 }
-}  // namespace
 
-PolygonMap gridToPolygon(const OccupancyGrid& grid, const GridConversionOptions& options, const std::string& source,
-                         GridConversionReport* report)
+/// The free mask (counted into @p info) and the free region to keep (its label's cells).
+std::vector<char> chooseRegion(const OccupancyGrid& grid, const GridConversionOptions& options,
+                               const std::string& source, GridConversionReport* info)
 {
-  const std::vector<std::string> issues = grid.validate();
-  if (!issues.empty())
-  {
-    throw MapError(source, 0, "invalid occupancy grid: " + issues.front());
-  }
-  checkOptions(options, source);
-  GridConversionReport info;
-  const double res = grid.resolution;
-  info.tolerance_used = options.tolerance > 0.0 ? options.tolerance : res;
-  info.min_area_used = options.min_area >= 0.0 ? options.min_area : 10.0 * res * res;
-
-  const int w = grid.width;
-  const int h = grid.height;
   std::vector<char> free(grid.cells.size(), 0);
   for (std::size_t i = 0; i < grid.cells.size(); ++i)
   {
     free[i] = grid.cells[i] >= 0 && grid.cells[i] < options.occupied_threshold;
-    info.free_cells += free[i];
+    info->free_cells += free[i];
   }
-  if (info.free_cells == 0)
+  if (info->free_cells == 0)
   {
     throw MapError(source, 0,
-                   "no free cell in the " + std::to_string(w) + " x " + std::to_string(h) +
+                   "no free cell in the " + std::to_string(grid.width) + " x " + std::to_string(grid.height) +
                        " grid (every cell is occupied or unknown): nothing to localize in");
   }
   std::vector<int> labels;
   std::vector<long> sizes;
-  info.regions = labelRegions(free, w, h, &labels, &sizes);
-
-  int chosen = 0;
+  info->regions = labelRegions(free, grid.width, grid.height, &labels, &sizes);
+  int chosen = static_cast<int>(std::max_element(sizes.begin(), sizes.end()) - sizes.begin());
   if (options.use_seed)
   {
     int ix = 0;
@@ -228,51 +129,89 @@ PolygonMap gridToPolygon(const OccupancyGrid& grid, const GridConversionOptions&
                          std::to_string(iy) + ") of value " + std::to_string(grid.at(ix, iy)));
     }
   }
-  else
-  {
-    chosen = static_cast<int>(std::max_element(sizes.begin(), sizes.end()) - sizes.begin());
-  }
-  info.region_cells = sizes[chosen];
-
-  std::vector<char> region(free.size(), 0);
+  info->region_cells = sizes[chosen];
   for (std::size_t i = 0; i < labels.size(); ++i)
   {
-    region[i] = labels[i] == chosen;
+    free[i] = labels[i] == chosen;
   }
-  std::vector<Ring> contours = traceBoundaries(region, w, h);
-  // The outer boundary is the one counter-clockwise ring; every clockwise ring is a hole.
-  std::vector<Ring> rings(1);
-  double outer_area = 0.0;
-  const double min_area_cells = info.min_area_used / (res * res);
-  for (Ring& ring : contours)
+  return free;
+}
+
+/**
+ * The region's rings in cell units: the outer boundary first (the counter-clockwise ring of
+ * largest area), then every hole (clockwise) of at least @p min_area_cells. Areas are those of
+ * the cell-edge rings (cells enclosed), whatever the walls' offset.
+ */
+std::vector<Ring> regionRings(const std::vector<char>& region, int width, int height, GridWalls walls,
+                              double min_area_cells, GridConversionReport* info)
+{
+  const std::vector<Ring> edges = traceRegionBoundaries(region, width, height, 0.0);
+  std::vector<Ring> shifted;
+  if (walls == GridWalls::Measured)
   {
-    const double area = ringAreaCells(ring);
-    if (area > outer_area)
-    {
-      outer_area = area;
-      rings[0].swap(ring);
-    }
+    shifted = traceRegionBoundaries(region, width, height, kMeasuredWallOffset);
   }
-  for (Ring& ring : contours)
+  const std::vector<Ring>& traced = walls == GridWalls::Measured ? shifted : edges;
+  std::size_t outer = 0;
+  for (std::size_t i = 0; i < edges.size(); ++i)
   {
-    if (ring.empty())
+    outer = signedArea(edges[i]) > signedArea(edges[outer]) ? i : outer;
+  }
+  std::vector<Ring> rings{ traced[outer] };
+  for (std::size_t i = 0; i < edges.size(); ++i)
+  {
+    const double area = signedArea(edges[i]);
+    if (i == outer || area >= 0.0)
     {
-      continue;
+      continue;  // the outer ring; no other ring of a 4-connected region is counter-clockwise
     }
-    const double area = ringAreaCells(ring);
-    if (area >= 0.0)
-    {
-      continue;  // cannot happen for a 4-connected region; ignore defensively
-    }
-    ++info.holes_found;
+    ++info->holes_found;
     if (-area < min_area_cells)
     {
-      ++info.holes_dropped;
+      ++info->holes_dropped;
       continue;
     }
-    rings.push_back(std::move(ring));
+    rings.push_back(traced[i]);
   }
-  // Simplify in cell units, where every traced vertex is a multiple of 1/8 cell, so the
+  return rings;
+}
+}  // namespace
+
+GridWalls parseGridWalls(const std::string& text)
+{
+  if (text == "measured")
+  {
+    return GridWalls::Measured;
+  }
+  if (text == "cell_edges")
+  {
+    return GridWalls::CellEdges;
+  }
+  throw std::invalid_argument("unknown grid walls '" + text + "' (allowed: measured, cell_edges)");
+}
+
+const char* toString(GridWalls walls)
+{
+  return walls == GridWalls::CellEdges ? "cell_edges" : "measured";
+}
+
+PolygonMap gridToPolygon(const OccupancyGrid& grid, const GridConversionOptions& options, const std::string& source,
+                         GridConversionReport* report)
+{
+  const std::vector<std::string> issues = grid.validate();
+  if (!issues.empty())
+  {
+    throw MapError(source, 0, "invalid occupancy grid: " + issues.front());
+  }
+  checkOptions(options, source);
+  GridConversionReport info;
+  const double res = grid.resolution;
+  info.tolerance_used = options.tolerance > 0.0 ? options.tolerance : res;
+  info.min_area_used = options.min_area >= 0.0 ? options.min_area : 10.0 * res * res;
+  const std::vector<char> region = chooseRegion(grid, options, source, &info);
+  const std::vector<Ring> rings =
+      regionRings(region, grid.width, grid.height, options.walls, info.min_area_used / (res * res), &info);
+  // Simplify in cell units, where every traced vertex is a multiple of 1/32 cell, so the
   // touching and crossing tests are exact; then scale and apply the origin pose.
   for (const Ring& ring : rings)
   {

@@ -100,6 +100,47 @@ const char* toString(MapMode mode)
   }
 }
 
+namespace
+{
+/// One cell from one pixel (map_server's rules, see pixelsToGrid()).
+std::int8_t pixelToCell(const std::uint8_t* p, int channels, const MapYaml& meta)
+{
+  const bool has_alpha = channels == 2 || channels == 4;
+  // As map_server: trinary mode averages the alpha channel in with the colours.
+  const int avg_channels = (meta.mode == MapMode::Trinary || !has_alpha) ? channels : channels - 1;
+  int sum = 0;
+  for (int k = 0; k < avg_channels; ++k)
+  {
+    sum += p[k];
+  }
+  double value = static_cast<double>(sum) / avg_channels;
+  const int alpha = has_alpha ? p[channels - 1] : 255;
+  if (meta.negate)
+  {
+    value = 255.0 - value;
+  }
+  if (meta.mode == MapMode::Raw)
+  {
+    return static_cast<std::int8_t>(static_cast<std::uint8_t>(value));
+  }
+  const double occ = (255.0 - value) / 255.0;
+  if (occ > meta.occupied_thresh)
+  {
+    return 100;
+  }
+  if (occ < meta.free_thresh)
+  {
+    return 0;
+  }
+  if (meta.mode == MapMode::Trinary || alpha == 0)
+  {
+    return -1;
+  }
+  const double ratio = (occ - meta.free_thresh) / (meta.occupied_thresh - meta.free_thresh);
+  return static_cast<std::int8_t>(99.0 * ratio);
+}
+}  // namespace
+
 OccupancyGrid pixelsToGrid(const std::uint8_t* pixels, int width, int height, int channels, const MapYaml& meta)
 {
   if (width <= 0 || height <= 0 || channels < 1 || channels > 4 || pixels == nullptr)
@@ -112,55 +153,13 @@ OccupancyGrid pixelsToGrid(const std::uint8_t* pixels, int width, int height, in
   grid.resolution = meta.resolution;
   grid.origin = meta.origin;
   grid.cells.assign(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), -1);
-
-  const bool has_alpha = channels == 2 || channels == 4;
-  // As map_server: trinary mode averages the alpha channel in with the colours.
-  const int avg_channels = (meta.mode == MapMode::Trinary || !has_alpha) ? channels : channels - 1;
   for (int row = 0; row < height; ++row)
   {
     const int iy = height - 1 - row;  // the first image row is the top of the map
     for (int ix = 0; ix < width; ++ix)
     {
-      const std::uint8_t* p =
-          pixels + (static_cast<std::size_t>(row) * static_cast<std::size_t>(width) + ix) * channels;
-      int sum = 0;
-      for (int k = 0; k < avg_channels; ++k)
-      {
-        sum += p[k];
-      }
-      double value = static_cast<double>(sum) / avg_channels;
-      const int alpha = has_alpha ? p[channels - 1] : 255;
-      if (meta.negate)
-      {
-        value = 255.0 - value;
-      }
-      std::int8_t cell = -1;
-      if (meta.mode == MapMode::Raw)
-      {
-        cell = static_cast<std::int8_t>(static_cast<std::uint8_t>(value));
-      }
-      else
-      {
-        const double occ = (255.0 - value) / 255.0;
-        if (occ > meta.occupied_thresh)
-        {
-          cell = 100;
-        }
-        else if (occ < meta.free_thresh)
-        {
-          cell = 0;
-        }
-        else if (meta.mode == MapMode::Trinary || alpha == 0)
-        {
-          cell = -1;
-        }
-        else
-        {
-          const double ratio = (occ - meta.free_thresh) / (meta.occupied_thresh - meta.free_thresh);
-          cell = static_cast<std::int8_t>(99.0 * ratio);
-        }
-      }
-      grid.at(ix, iy) = cell;
+      const std::size_t pixel = static_cast<std::size_t>(row) * static_cast<std::size_t>(width) + ix;
+      grid.at(ix, iy) = pixelToCell(pixels + pixel * channels, channels, meta);
     }
   }
   return grid;

@@ -1,9 +1,12 @@
 // Localization on a map converted from an occupancy grid, with readings simulated on the
 // original polygon map: the conversion must keep the map faithful enough to localize in.
 #include "fdml_localization/core/map/grid/grid_to_polygon.h"
+#include "fdml_localization/core/map/grid/grid_tolerances.h"
 #include "fdml_localization/core/localization/localizer.h"
 #include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/io/map_files.h"
+
+#include "grid_test_maps.h"
 
 #include <gtest/gtest.h>
 
@@ -19,10 +22,7 @@ namespace io = fdml_localization::io;
 
 namespace
 {
-double uniform(std::mt19937_64& rng)
-{
-  return static_cast<double>(rng() >> 11) * (1.0 / 9007199254740992.0);
-}
+using grid_test::uniform;
 
 /// A random free pose at least @p clearance [m] from every wall of @p map.
 core::Pose2 randomPose(const core::MapRayCaster& map, double clearance, std::mt19937_64& rng)
@@ -89,8 +89,7 @@ TEST(GridLocalization, ConvertedShippedGridLocalizesAsWellAsTheOriginalMap)
   // The converted walls lie within about a cell (5 cm) of the true ones, wall noise included:
   // the range and agreement tolerances follow (the defaults, 2 and 5 cm, lose the truth in
   // 2 of these 12 trials to a symmetric place that happens to fit the noisy walls better).
-  options.range_tolerance = 0.05;
-  options.agreement_tolerance = 0.1;
+  options = core::withGridTolerances(options, 0.05);  // 5 and 10 cm
   core::Localizer on_original(original, options);
   core::Localizer on_converted(converted, options);
 

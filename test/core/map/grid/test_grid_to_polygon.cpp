@@ -1,13 +1,14 @@
 // Occupancy grid -> polygon: exact tracing, validity under simplification, specks, seeds,
 // and ray casts on the converted polygon against an independent ray walk on the grid.
 #include "fdml_localization/core/map/grid/grid_to_polygon.h"
+
+#include "grid_test_maps.h"
 #include "fdml_localization/core/map/grid/grid_raster.h"
 #include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/core/geometry/ray_caster.h"
 #include "fdml_localization/io/map_files.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -20,39 +21,11 @@ namespace fs = std::filesystem;
 namespace core = fdml_localization::core;
 namespace io = fdml_localization::io;
 using core::Vec2;
+using grid_test::officeMap;
+using grid_test::uniform;
 
 namespace
 {
-double uniform(std::mt19937_64& rng)
-{
-  return static_cast<double>(rng() >> 11) * (1.0 / 9007199254740992.0);
-}
-
-/// A 12 x 8 m office: two wall stubs off the outer wall, a pillar, a desk block, a partition
-/// and a rotated square column.
-core::PolygonMap officeMap()
-{
-  std::vector<core::Ring> rings = {
-    { { 0, 0 },
-      { 12, 0 },
-      { 12, 8 },
-      { 7.1, 8 },
-      { 7.1, 5 },
-      { 6.9, 5 },
-      { 6.9, 8 },
-      { 0, 8 },
-      { 0, 4.1 },
-      { 3, 4.1 },
-      { 3, 3.9 },
-      { 0, 3.9 } },
-    { { 5, 1.5 }, { 5.3, 1.5 }, { 5.3, 1.8 }, { 5, 1.8 } },
-    { { 9, 2 }, { 11, 2 }, { 11, 3 }, { 9, 3 } },
-    { { 9, 5.5 }, { 9.2, 5.5 }, { 9.2, 7 }, { 9, 7 } },
-    { { 2, 6 }, { 2.4, 6.3 }, { 2, 6.6 }, { 1.6, 6.3 } },
-  };
-  return core::PolygonMap::fromRings(rings, "office");
-}
-
 std::vector<char> freeMask(const core::OccupancyGrid& g, int threshold = 50)
 {
   std::vector<char> free(g.cells.size());
@@ -204,9 +177,11 @@ RayStats compareRays(const core::OccupancyGrid& g, const core::PolygonMap& map, 
   return stats;
 }
 
+/// Unsimplified, walls on the cell edges: the tracing itself.
 core::GridConversionOptions exact()
 {
   core::GridConversionOptions o;
+  o.walls = core::GridWalls::CellEdges;
   o.tolerance = 1e-9;
   o.min_area = 0.0;
   return o;
@@ -349,7 +324,10 @@ TEST(GridToPolygon, SpecksAndIslandsAreDroppedAndRoomsKept)
   raster.seed = 11;
   const core::OccupancyGrid g = core::rasterize(office, raster);
   core::GridConversionReport report;
-  const core::PolygonMap map = core::gridToPolygon(g, {}, "office grid", &report);
+  // The rasteriser frees the cells whose centre is in free space: the walls are on the edges.
+  core::GridConversionOptions options;
+  options.walls = core::GridWalls::CellEdges;
+  const core::PolygonMap map = core::gridToPolygon(g, options, "office grid", &report);
   EXPECT_EQ(map.holeCount(), office.holeCount());
   EXPECT_GE(report.holes_dropped, 40);
   EXPECT_GE(report.regions, 11);
@@ -363,32 +341,10 @@ TEST(GridToPolygon, SpecksAndIslandsAreDroppedAndRoomsKept)
   EXPECT_GT(map.area(), office.area() - perimeter * raster.resolution);
 }
 
-TEST(GridToPolygon, SeedPointPicksItsOwnRoom)
-{
-  core::OccupancyGrid g;
-  g.width = 30;
-  g.height = 10;
-  g.resolution = 0.2;
-  g.cells.assign(300, 100);
-  for (int iy = 1; iy < 9; ++iy)
-  {
-    for (int ix = 1; ix < 29; ++ix)
-    {
-      g.at(ix, iy) = (ix == 20) ? 100 : 0;  // a big room (x < 20) and a small one
-    }
-  }
-  core::GridConversionOptions options = exact();
-  const double big = core::gridToPolygon(g, options).area();
-  options.use_seed = true;
-  options.seed_point = Vec2(4.5, 1.0);  // cell (22, 5): the small room
-  const double small = core::gridToPolygon(g, options).area();
-  EXPECT_NEAR(big, 19 * 8 * 0.04, 1e-9);
-  EXPECT_NEAR(small, 8 * 8 * 0.04, 1e-9);
-}
-
 TEST(GridToPolygon, RayCastsAgreeWithTheGridItself)
 {
-  // Unsimplified, a ray meets the polygon where it meets the first non-free cell (up to the
+  // With the walls on the cell edges and unsimplified, a ray meets the polygon where it meets
+  // the first non-free cell (up to the
   // 1/8-cell chamfers at corner contacts). Simplified by one cell, noise-free walls still
   // agree; one-cell noise bumps along the walls are smoothed away, which rays at grazing
   // angles see as larger differences.
@@ -416,6 +372,7 @@ TEST(GridToPolygon, RayCastsAgreeWithTheGridItself)
     {
       g.origin = core::Pose2(2.0, -1.0, yaw);
       core::GridConversionOptions options;
+      options.walls = core::GridWalls::CellEdges;
       options.tolerance = c.tolerance;
       options.min_area = 0.0;
       const core::PolygonMap map = core::gridToPolygon(g, options);
@@ -427,87 +384,5 @@ TEST(GridToPolygon, RayCastsAgreeWithTheGridItself)
       EXPECT_GE(stats.within_two_cells, c.min_within_two) << label;
       EXPECT_LE(stats.median_cells, 0.1) << label;
     }
-  }
-}
-
-TEST(GridToPolygon, LoadMapFileDispatchesOnTheExtension)
-{
-  const fs::path dir = fs::temp_directory_path() / ("fdml_g2p_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  const core::PolygonMap office = officeMap();
-  core::savePolyFile((dir / "office.poly").string(), office);
-  io::saveOccupancyGridYaml((dir / "office.yaml").string(), core::rasterize(office, {}));
-  const core::PolygonMap from_poly = io::loadMapFile((dir / "office.poly").string());
-  const core::PolygonMap from_yaml = io::loadMapFile((dir / "office.yaml").string());
-  fs::remove_all(dir);
-  EXPECT_EQ(from_poly.hash(), office.hash());
-  EXPECT_EQ(from_yaml.holeCount(), office.holeCount());
-  EXPECT_NEAR(from_yaml.area(), office.area(), 0.5);
-}
-
-TEST(ShippedGrids, AreReproducibleFromTheirPolygonsAndConvertBack)
-{
-  struct Shipped
-  {
-    const char* name;
-    double noise;
-    int specks;
-    int islands;
-    std::uint64_t seed;
-  };
-  // The commands in docs/maps_occupancy.md.
-  const Shipped maps[] = { { "office", 0.1, 40, 12, 7 }, { "apartment", 0.05, 20, 6, 3 } };
-  for (const Shipped& m : maps)
-  {
-    const std::string base = std::string(FDML_SOURCE_DIR) + "/maps/" + m.name;
-    const core::PolygonMap original = core::loadPolyFile(base + ".poly");
-    core::RasterizeOptions raster;
-    raster.boundary_noise = m.noise;
-    raster.specks = m.specks;
-    raster.islands = m.islands;
-    raster.seed = m.seed;
-    const core::OccupancyGrid made = core::rasterize(original, raster);
-    const core::OccupancyGrid shipped = io::loadOccupancyGridYaml(base + "_grid.yaml");
-    EXPECT_EQ(shipped.width, made.width) << m.name;
-    EXPECT_EQ(shipped.height, made.height) << m.name;
-    EXPECT_EQ(shipped.cells, made.cells) << m.name;
-    EXPECT_NEAR(shipped.origin.x, made.origin.x, 1e-12) << m.name;
-
-    core::GridConversionReport report;
-    const core::PolygonMap converted = core::gridToPolygon(shipped, {}, m.name, &report);
-    EXPECT_EQ(converted.holeCount(), original.holeCount()) << m.name;
-    EXPECT_EQ(report.holes_dropped, m.specks) << m.name;
-    EXPECT_EQ(report.regions, 1 + m.islands) << m.name;
-    double perimeter = 0.0;
-    for (const core::Segment& e : original.edges())
-    {
-      perimeter += (e.b - e.a).norm();
-    }
-    EXPECT_LT(std::abs(converted.area() - original.area()), 0.5 * perimeter * shipped.resolution) << m.name;
-
-    // Ray casts on the converted map against the original polygon (the ground truth).
-    const core::MapRayCaster truth(original);
-    const core::MapRayCaster conv(converted);
-    std::mt19937_64 rng(m.seed);
-    int rays = 0;
-    int within_one = 0;
-    int within_two = 0;
-    while (rays < 2000)
-    {
-      const Vec2 p(original.bounds().min.x() + uniform(rng) * original.bounds().size().x(),
-                   original.bounds().min.y() + uniform(rng) * original.bounds().size().y());
-      if (!truth.isFree(p))
-      {
-        continue;
-      }
-      const core::Pose2 sensor(p.x(), p.y(), core::kTwoPi * uniform(rng));
-      const double error = std::abs(truth.range(sensor) - conv.range(sensor)) / shipped.resolution;
-      ++rays;
-      within_one += error <= 1.0;
-      within_two += error <= 2.0;
-    }
-    // Measured: office 89.7 % / 97.3 %, apartment 94.6 % / 98.7 % (wall noise seen at grazing angles).
-    EXPECT_GE(within_one, 0.85 * rays) << m.name;
-    EXPECT_GE(within_two, 0.95 * rays) << m.name;
   }
 }

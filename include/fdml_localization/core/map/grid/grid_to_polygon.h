@@ -14,9 +14,27 @@ namespace fdml_localization
 {
 namespace core
 {
+/// Where gridToPolygon() puts a wall between a free cell and a wall cell.
+enum class GridWalls
+{
+  /// Through the boundary wall cells (1/16 cell short of their centres): where a range sensor
+  /// measures the wall on average when the grid was made by ray casting (a SLAM map: the cell
+  /// holding each laser hit is occupied, the cells the ray crossed are free).
+  Measured,
+  /// On the free cells' edges: for grids whose free cells are those with their centre in free
+  /// space (a floor plan rasterised by cell centres).
+  CellEdges
+};
+
+/// Parses "measured" / "cell_edges"; throws std::invalid_argument otherwise.
+GridWalls parseGridWalls(const std::string& text);
+const char* toString(GridWalls walls);
+
 /// Options of gridToPolygon().
 struct GridConversionOptions
 {
+  /// Where the walls go (see GridWalls).
+  GridWalls walls = GridWalls::Measured;
   /// Douglas-Peucker tolerance [m]; <= 0 picks one cell (the grid's resolution).
   double tolerance = 0.0;
   /// Obstacles (holes) of smaller area are dropped as noise [m^2]; < 0 picks 10 cells' area.
@@ -48,9 +66,10 @@ struct GridConversionReport
  * @brief Converts an occupancy grid into a valid polygon with holes.
  *
  * Picks the 4-connected free region holding the seed (or the largest), traces its boundary
- * along the cell edges (so before simplification a ray meets the polygon where it meets the
- * first non-free cell; where two wall cells touch only at a corner the wall stays closed,
- * with a 1/8-cell chamfer off the free cells' corners there), drops holes under min_area,
+ * through the boundary wall cells (GridWalls::Measured) or along the cell edges (CellEdges: so
+ * before simplification a ray meets the polygon where it meets the first non-free cell), see
+ * traceRegionBoundaries(); where two wall cells touch only at a corner the wall stays closed.
+ * Drops holes under min_area (the area of the hole's cells, whatever options.walls),
  * simplifies every ring with Douglas-Peucker and, where that would make rings cross or touch,
  * simplifies those rings again with a smaller tolerance. The origin's yaw is applied.
  *

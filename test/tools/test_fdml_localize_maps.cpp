@@ -1,0 +1,101 @@
+// fdml_localize takes every map the core loads (a .poly, a map_server .yaml, a .poly converted
+// from a grid), and a map from a grid gets the grid tolerances unless they are given.
+#include "fdml_localization/core/map/grid/grid_raster.h"
+#include "fdml_localization/core/map/grid/grid_tolerances.h"
+#include "fdml_localization/io/map_files.h"
+
+#include "localizer_test_utils.h"
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace fdml_localization
+{
+namespace core
+{
+namespace
+{
+namespace fs = std::filesystem;
+
+struct Best
+{
+  int status = -1;
+  Pose2 pose;
+  int inliers = -1;
+};
+
+/// Runs fdml_localize with @p args and parses its best candidate.
+Best runLocalize(const std::string& args, const fs::path& dir)
+{
+  const std::string out = (dir / "out.txt").string();
+  const int status = std::system(
+      (std::string(FDML_LOCALIZE_EXE) + " " + args + " > " + out + " 2> " + (dir / "err.txt").string()).c_str());
+  Best best;
+  best.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream in(out);
+  std::string line;
+  std::getline(in, line);  // header
+  char comma = 0;
+  int rank = 0;
+  if (in >> rank >> comma >> best.pose.x >> comma >> best.pose.y >> comma >> best.pose.theta >> comma >> best.inliers)
+  {
+    return best;
+  }
+  best.inliers = -1;
+  return best;
+}
+}  // namespace
+
+TEST(LocalizeMaps, PolyYamlAndConvertedPolyAlikeWithGridTolerances)
+{
+  const fs::path dir = fs::temp_directory_path() / ("fdml_localize_maps_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const auto room = test::lRoomMap();  // walls on multiples of 5 cm: on the grid's cell edges
+  savePolyFile((dir / "room.poly").string(), room->map());
+  io::saveOccupancyGridYaml((dir / "room.yaml").string(), rasterize(room->map(), RasterizeOptions{}));
+  const io::MapFile converted = io::readMapFile((dir / "room.yaml").string());
+  savePolyFile((dir / "converted.poly").string(), converted.map, cellSizeHeader(converted.cell_size));
+
+  // Ten exact readings, one of them 6 cm short: beyond the default 5 cm agreement tolerance on
+  // the polygon, within the 10 cm of a 5 cm grid (whose walls lie 2.3 cm beyond the plan's).
+  const Pose2 truth(6.1, 3.2, -0.4);
+  std::vector<Reading> readings = test::exactReadings(*room, truth, test::inPlaceOffsets(10));
+  readings[3].range -= 0.06;
+  std::ofstream csv(dir / "r.csv");
+  csv.precision(17);
+  csv << "gx,gy,gtheta,d\n";
+  for (const Reading& r : readings)
+  {
+    csv << r.offset.x << "," << r.offset.y << "," << r.offset.theta << "," << r.range << "\n";
+  }
+  csv.close();
+  const std::string csv_path = (dir / "r.csv").string();
+  struct Case
+  {
+    std::string args;
+    int inliers;
+  };
+  const Case cases[] = {
+    { "--map " + (dir / "room.poly").string(), 9 },
+    { "--map " + (dir / "room.yaml").string(), 10 },
+    { "--map " + (dir / "converted.poly").string(), 10 },
+    { "--map " + (dir / "room.yaml").string() + " --tolerance 0.05", 9 },  // as given
+  };
+  for (const Case& c : cases)
+  {
+    const Best best = runLocalize(c.args + " " + csv_path, dir);
+    EXPECT_EQ(best.status, 0) << c.args;
+    EXPECT_LT(test::positionError(best.pose, truth), 0.05) << c.args;
+    EXPECT_EQ(best.inliers, c.inliers) << c.args;
+  }
+  fs::remove_all(dir);
+}
+
+}  // namespace core
+}  // namespace fdml_localization

@@ -385,7 +385,8 @@ SimReading Simulation::readSensor(int index)
   reading.sensor = index;
   reading.time = time_;
   reading.sensor_pose = compose(true_pose_, s.mount);
-  const SceneHit hit = scene_.cast(reading.sensor_pose, s.max_range);
+  // A sensor with a field of view reports the nearest point within its cone (cone_cast.h).
+  const SceneHit hit = scene_.castCone(reading.sensor_pose, 0.5 * s.fov, s.max_range);
   reading.kind = hit.kind;
   reading.obstacle = hit.obstacle;
   reading.true_range = hit.distance;

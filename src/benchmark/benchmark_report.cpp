@@ -62,7 +62,7 @@ const std::vector<std::string>& headers()
 std::string csvHeader()
 {
   return "scene,m,n,method,trial,success_paper,success_strict,success_top1,candidates,time_ms,"
-         "sparsity_held,err_pos,err_theta";
+         "sparsity_held,err_pos,err_theta,fov_deg";
 }
 
 std::string csvRow(const BenchRow& r)
@@ -80,6 +80,7 @@ std::string csvRow(const BenchRow& r)
   {
     out << ',';
   }
+  out << ',' << format("%g", r.fov_deg);
   return out.str();
 }
 

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -231,13 +232,18 @@ TEST(ScenarioParsing, TimeScaleNeedsTheClock)
 
 TEST(ScenarioParsing, ShippedScenariosAreValid)
 {
-  const std::string dir = std::string(FDML_SOURCE_DIR) + "/config/scenarios/";
-  for (const char* name : { "paper_table1.yaml", "office_moving.yaml", "apartment.yaml", "square_noiseless.yaml",
-                            "warehouse_teleop.yaml", "corridor_people.yaml" })
+  // Every file in config/scenarios/ (at least the eight shipped ones).
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(std::string(FDML_SOURCE_DIR) + "/config/scenarios"))
   {
-    SCOPED_TRACE(name);
+    if (entry.path().extension() != ".yaml")
+    {
+      continue;
+    }
+    ++files;
+    SCOPED_TRACE(entry.path().filename().string());
     core::ScenarioConfig c;
-    const auto errors = core::parseScenario(fromYaml(YAML::LoadFile(dir + name)), &c);
+    const auto errors = core::parseScenario(fromYaml(YAML::LoadFile(entry.path().string())), &c);
     ASSERT_TRUE(errors.empty()) << joined(errors);
     const std::string prefix = "package://fdml_localization/";
     ASSERT_EQ(c.map_file.rfind(prefix, 0), 0u);
@@ -246,6 +252,7 @@ TEST(ScenarioParsing, ShippedScenariosAreValid)
     std::vector<std::string> sim_errors;
     EXPECT_NE(core::Simulation::create(c, map, &sim_errors), nullptr) << joined(sim_errors);
   }
+  EXPECT_GE(files, 8);
 }
 
 TEST(SimulationCreate, ObstaclesThatDoNotFitAreNamed)

@@ -99,6 +99,18 @@ public:
   }
 
 private:
+  /// Fills the cells' compressed rows of segment indices.
+  void buildCells();
+  /// Calls fn(cell index) for every cell the segment touches (cells inflated by a margin).
+  template <typename Fn>
+  void forEachCellTouching(const Segment& s, Fn&& fn) const;
+  /// Clips origin + t dir to the grid's box: [t_enter, t_exit] narrowed; false when it misses.
+  bool clipToBounds(const Vec2& origin, const Vec2& dir, double* t_enter, double* t_exit) const;
+  /// Makes @p best the nearest of itself and the cell's segments hit (ties: the lower index).
+  void castInCell(std::size_t cell, const Vec2& origin, const Vec2& dir, RayHit* best) const;
+  /// Ray parameter at which origin + t dir leaves cell column/row @p c through its border on
+  /// the @p step side along @p axis (+inf when dir is parallel to that border).
+  double nextBorder(const Vec2& origin, const Vec2& dir, int axis, int c, int step) const;
   int cellX(double x) const;
   int cellY(double y) const;
 

@@ -3,6 +3,7 @@
 // pose built from the ground_truth topic and the static tf of the sensor mounting.
 #include "fdml_localization/Kidnap.h"
 #include "fdml_localization/ReadingTruth.h"
+#include "fdml_localization/core/geometry/cone_cast.h"
 #include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/ros/conversions.h"
 #include "fdml_localization/ros/param_utils.h"
@@ -165,7 +166,9 @@ TEST_F(Noiseless, EveryRangeEqualsAnIndependentRayCast)
       continue;  // its ground truth has not arrived yet
     }
     const core::Pose2 sensor = core::compose(gt->second, mount(r.header.frame_id));
-    const double expected = caster_->range(sensor, r.max_range);
+    // A sensor with a field of view reads the nearest point within its cone (brute force).
+    const double expected =
+        core::coneRangeBruteForce(caster_->grid().segments(), sensor, 0.5 * r.field_of_view, r.max_range);
     expectRangeEq(r.range, expected, 1e-4, r.header.frame_id);
     per_frame[r.header.frame_id]++;
     misses += std::isinf(expected) ? 1 : 0;
@@ -348,10 +351,12 @@ TEST_F(Obstacles, HitLabelsMatchIndependentCasts)
 {
   ASSERT_TRUE(waitFor([this]() { return truths_.size() >= 600; })) << truths_.size() << " readings";
   std::map<std::string, double> max_range;
+  std::map<std::string, double> half_angle;
   ASSERT_TRUE(waitFor([&]() { return !ranges_.empty(); }));
   for (const auto& r : ranges_)
   {
     max_range[r.header.frame_id] = r.max_range;
+    half_angle[r.header.frame_id] = 0.5 * r.field_of_view;
   }
   std::map<int, int> kinds;
   int checked = 0;
@@ -368,8 +373,10 @@ TEST_F(Obstacles, HitLabelsMatchIndependentCasts)
     const core::Pose2 sensor = core::compose(gt->second, mount(t.header.frame_id));
     EXPECT_NEAR(t.sensor_pose.x, sensor.x, 1e-9);
     EXPECT_NEAR(t.sensor_pose.y, sensor.y, 1e-9);
-    // Independent cast: the static map, then every obstacle as published.
-    const double map_range = caster_->range(sensor, m);
+    // Independent cast of the cone: the static map edge by edge, then every obstacle as published.
+    const core::Sector sector = core::Sector::around(sensor, half_angle[t.header.frame_id]);
+    const double map_range =
+        core::coneRangeBruteForce(caster_->grid().segments(), sensor, half_angle[t.header.frame_id], m);
     double best = map_range;
     int kind = std::isinf(map_range) ? fl::ReadingTruth::HIT_NONE : fl::ReadingTruth::HIT_MAP;
     int id = -1;
@@ -378,8 +385,7 @@ TEST_F(Obstacles, HitLabelsMatchIndependentCasts)
       double d = core::kInf;
       if (o.type == visualization_msgs::Marker::CYLINDER)
       {
-        d = core::rayCircleDistance(sensor.position(), sensor.heading(),
-                                    core::Vec2(o.pose.position.x, o.pose.position.y), 0.5 * o.scale.x);
+        d = core::sectorCircleDistance(sector, core::Vec2(o.pose.position.x, o.pose.position.y), 0.5 * o.scale.x);
       }
       else
       {
@@ -387,7 +393,7 @@ TEST_F(Obstacles, HitLabelsMatchIndependentCasts)
         {
           const core::Segment edge{ core::Vec2(o.points[k].x, o.points[k].y),
                                     core::Vec2(o.points[k + 1].x, o.points[k + 1].y) };
-          d = std::min(d, core::raySegmentDistance(sensor.position(), sensor.heading(), edge));
+          d = std::min(d, core::sectorSegmentDistance(sector, edge));
         }
       }
       if (d <= m && d < best)

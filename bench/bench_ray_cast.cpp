@@ -2,9 +2,11 @@
 // office and warehouse maps (and a large generated building), on 1 and 2 threads.
 // Each iteration casts a fixed batch of rays from random free points in an OpenMP loop;
 // items_per_second is rays per second (wall-clock).
+// ConeCast: the exact cone cast (core/geometry/cone_cast.h) of the same batch for fields of view
+// of 0 (the ray), 2, 15, 27 and 30 deg, one thread; items_per_second is cones per second.
 #include "fdml_localization/simulation/map_generators.h"
 #include "fdml_localization/core/map/map_io.h"
-#include "fdml_localization/core/geometry/ray_caster.h"
+#include "fdml_localization/core/geometry/cone_cast.h"
 
 #include <benchmark/benchmark.h>
 #include <omp.h>
@@ -66,6 +68,23 @@ void castBatch(benchmark::State& state, std::shared_ptr<const core::MapRayCaster
   state.counters["edges"] = static_cast<double>(grid.segments().size());
 }
 
+void coneBatch(benchmark::State& state, std::shared_ptr<const core::MapRayCaster> caster, double fov_deg)
+{
+  const RayBatch batch = makeBatch(*caster, 1234);
+  const double half_angle = 0.5 * fov_deg * core::kPi / 180.0;
+  for (auto _ : state)
+  {
+    double sum = 0.0;
+    for (int i = 0; i < kBatch; ++i)
+    {
+      const double theta = std::atan2(batch.dirs[i].y(), batch.dirs[i].x());
+      sum += core::coneRange(*caster, core::Pose2(batch.origins[i].x(), batch.origins[i].y(), theta), half_angle);
+    }
+    benchmark::DoNotOptimize(sum);
+  }
+  state.SetItemsProcessed(state.iterations() * kBatch);
+}
+
 void registerAll()
 {
   std::vector<std::pair<std::string, std::shared_ptr<const core::MapRayCaster>>> maps;
@@ -86,6 +105,11 @@ void registerAll()
             "RayCast/" + name + (accelerated ? "/grid" : "/brute") + "/threads:" + std::to_string(threads);
         benchmark::RegisterBenchmark(label.c_str(), castBatch, caster, accelerated, threads)->UseRealTime();
       }
+    }
+    for (const double fov_deg : { 0.0, 2.0, 15.0, 27.0, 30.0 })
+    {
+      const std::string label = "ConeCast/" + name + "/fov_deg:" + std::to_string(static_cast<int>(fov_deg));
+      benchmark::RegisterBenchmark(label.c_str(), coneBatch, caster, fov_deg)->UseRealTime();
     }
   }
 }

@@ -84,6 +84,10 @@ std::vector<std::string> validate(const ProtocolOptions& o)
   {
     issues.push_back("max_range must be > 0 [m] (+inf for unlimited)");
   }
+  if (!(o.half_angle >= 0.0 && o.half_angle <= kMaxConeHalfAngle))
+  {
+    issues.push_back("half_angle must be in [0, pi/2] [rad] (half the field of view; 0 = rays)");
+  }
   return issues;
 }
 
@@ -118,6 +122,140 @@ bool discInFreeSpace(const MapRayCaster& map, const Vec2& centre, double radius)
   return !touches;
 }
 
+namespace
+{
+/// The random draws of one trial, in the order the protocol has always made them.
+struct TrialDraw
+{
+  TrialDraw(const MapRayCaster& map_in, const ProtocolOptions& options_in, std::uint64_t seed)
+    : map(map_in)
+    , options(options_in)
+    , rng(seed)
+    , ux(map_in.map().bounds().min.x(), map_in.map().bounds().max.x())
+    , uy(map_in.map().bounds().min.y(), map_in.map().bounds().max.y())
+    , uangle(-kPi, kPi)
+  {}
+
+  const MapRayCaster& map;
+  const ProtocolOptions& options;
+  std::mt19937_64 rng;
+  std::uniform_real_distribution<double> ux;
+  std::uniform_real_distribution<double> uy;
+  std::uniform_real_distribution<double> uangle;
+
+  /// A random direction of length in [lo, hi) [m].
+  Vec2 randomStep(std::uniform_real_distribution<double>& length)
+  {
+    const double dir = uangle(rng);
+    return length(rng) * Vec2(std::cos(dir), std::sin(dir));
+  }
+};
+
+/// The robot pose in free space, then its path: 2 pi / k turn per reading, plus a
+/// collision-free step with translate.
+void drawRobotPath(TrialDraw& draw, Trial* trial)
+{
+  int attempts = 0;
+  do
+  {
+    if (++attempts > kMaxAttempts)
+    {
+      throw std::runtime_error("generateTrial: found no free robot position in the map");
+    }
+    trial->truth = Pose2(draw.ux(draw.rng), draw.uy(draw.rng), draw.uangle(draw.rng));
+  } while (!draw.map.isFree(trial->truth.position()));
+  std::uniform_real_distribution<double> ustep(draw.options.step_min, draw.options.step_max);
+  const double turn = kTwoPi / draw.options.readings;
+  trial->sensor_poses.push_back(trial->truth);
+  for (int i = 1; i < draw.options.readings; ++i)
+  {
+    const Pose2& prev = trial->sensor_poses.back();
+    Vec2 next = prev.position();
+    for (int a = 0; draw.options.translate && a < kStepAttempts; ++a)
+    {
+      const Vec2 cand = prev.position() + draw.randomStep(ustep);
+      if (draw.map.isFree(cand) && segmentFree(draw.map, prev.position(), cand))
+      {
+        next = cand;
+        break;
+      }
+    }
+    trial->sensor_poses.emplace_back(next.x(), next.y(), wrapAngle(trial->truth.theta + i * turn));
+  }
+}
+
+/// Discs fully in free space, never containing a sensor position.
+void drawObstacles(TrialDraw& draw, const std::vector<Vec2>& positions, Trial* trial)
+{
+  const double r = draw.options.obstacle_radius;
+  int attempts = 0;
+  while (static_cast<int>(trial->obstacles.size()) < draw.options.obstacles)
+  {
+    if (++attempts > kMaxAttempts)
+    {
+      throw std::runtime_error("generateTrial: no room for " + std::to_string(draw.options.obstacles) +
+                               " discs of radius " + std::to_string(r) + " m in the map");
+    }
+    const Vec2 c(draw.ux(draw.rng), draw.uy(draw.rng));
+    if (discAllowed(draw.map, c, r, positions))
+    {
+      trial->obstacles.push_back(Obstacle::disc(c, r));
+    }
+  }
+}
+
+/// Each obstacle takes a random step in free space, away from the sensor at @p position.
+void moveObstacles(TrialDraw& draw, const Vec2& position, std::vector<Obstacle>* obstacles)
+{
+  std::uniform_real_distribution<double> ustep(0.0, draw.options.obstacle_step);
+  for (Obstacle& o : *obstacles)
+  {
+    for (int a = 0; a < kStepAttempts; ++a)
+    {
+      const Vec2 c = o.centre + draw.randomStep(ustep);
+      if (discAllowed(draw.map, c, draw.options.obstacle_radius, { position }))
+      {
+        o.centre = c;
+        break;
+      }
+    }
+  }
+}
+
+/// The k readings: scene casts (cones of the options' half-angle) among the obstacles.
+void takeReadings(TrialDraw& draw, const std::shared_ptr<const MapRayCaster>& map, Trial* trial)
+{
+  const ProtocolOptions& options = draw.options;
+  std::normal_distribution<double> noise(0.0, options.noise > 0.0 ? options.noise : 1.0);
+  const double turn = kTwoPi / options.readings;
+  std::vector<Obstacle> obstacles = trial->obstacles;
+  Scene scene(map);
+  for (int i = 0; i < options.readings; ++i)
+  {
+    const Pose2& sensor = trial->sensor_poses[static_cast<std::size_t>(i)];
+    if (i > 0 && options.moving_obstacles)
+    {
+      moveObstacles(draw, sensor.position(), &obstacles);
+    }
+    scene.setObstacles(obstacles);
+    const SceneHit hit = scene.castCone(sensor, options.half_angle, options.max_range);
+    Reading reading;
+    reading.offset = options.translate ? between(trial->truth, sensor) : Pose2(0.0, 0.0, wrapAngle(i * turn));
+    reading.max_range = options.max_range;
+    reading.half_angle = options.half_angle;
+    reading.range = hit.distance;
+    if (std::isfinite(reading.range) && options.noise > 0.0)
+    {
+      reading.range = std::max(0.0, reading.range + noise(draw.rng));
+    }
+    const bool is_static = hit.kind == SceneHit::Kind::Map;
+    trial->readings.push_back(reading);
+    trial->hit_static.push_back(is_static);
+    trial->static_hits += is_static ? 1 : 0;
+  }
+}
+}  // namespace
+
 Trial generateTrial(const std::shared_ptr<const MapRayCaster>& map, const ProtocolOptions& options, std::uint64_t seed)
 {
   const std::vector<std::string> issues = validate(options);
@@ -135,111 +273,16 @@ Trial generateTrial(const std::shared_ptr<const MapRayCaster>& map, const Protoc
   {
     throw std::invalid_argument("generateTrial needs a non-empty map");
   }
-  std::mt19937_64 rng(seed);
-  const Box2& b = map->map().bounds();
-  std::uniform_real_distribution<double> ux(b.min.x(), b.max.x());
-  std::uniform_real_distribution<double> uy(b.min.y(), b.max.y());
-  std::uniform_real_distribution<double> uangle(-kPi, kPi);
-  std::uniform_real_distribution<double> ustep(options.step_min, options.step_max);
-  std::uniform_real_distribution<double> uobstacle_step(0.0, options.obstacle_step);
-  std::normal_distribution<double> noise(0.0, options.noise > 0.0 ? options.noise : 1.0);
-  const int k = options.readings;
-  const double turn = kTwoPi / k;
-
+  TrialDraw draw(*map, options, seed);
   Trial trial;
-  // Robot pose in free space.
-  int attempts = 0;
-  do
-  {
-    if (++attempts > kMaxAttempts)
-    {
-      throw std::runtime_error("generateTrial: found no free robot position in the map");
-    }
-    trial.truth = Pose2(ux(rng), uy(rng), uangle(rng));
-  } while (!map->isFree(trial.truth.position()));
-
-  // Robot path: turn by 2 pi / k per reading, plus a collision-free step with translate.
-  trial.sensor_poses.push_back(trial.truth);
-  for (int i = 1; i < k; ++i)
-  {
-    const Pose2& prev = trial.sensor_poses.back();
-    Vec2 next = prev.position();
-    if (options.translate)
-    {
-      for (int a = 0; a < kStepAttempts; ++a)
-      {
-        const double dir = uangle(rng);
-        const Vec2 cand = prev.position() + ustep(rng) * Vec2(std::cos(dir), std::sin(dir));
-        if (map->isFree(cand) && segmentFree(*map, prev.position(), cand))
-        {
-          next = cand;
-          break;
-        }
-      }
-    }
-    trial.sensor_poses.emplace_back(next.x(), next.y(), wrapAngle(trial.truth.theta + i * turn));
-  }
+  drawRobotPath(draw, &trial);
   std::vector<Vec2> positions;
   for (const Pose2& p : trial.sensor_poses)
   {
     positions.push_back(p.position());
   }
-
-  // Obstacles: discs fully in free space, never containing a sensor position.
-  const double r = options.obstacle_radius;
-  std::vector<Obstacle> obstacles;
-  attempts = 0;
-  while (static_cast<int>(obstacles.size()) < options.obstacles)
-  {
-    if (++attempts > kMaxAttempts)
-    {
-      throw std::runtime_error("generateTrial: no room for " + std::to_string(options.obstacles) + " discs of radius " +
-                               std::to_string(r) + " m in the map");
-    }
-    const Vec2 c(ux(rng), uy(rng));
-    if (discAllowed(*map, c, r, positions))
-    {
-      obstacles.push_back(Obstacle::disc(c, r));
-    }
-  }
-  trial.obstacles = obstacles;
-
-  // Readings.
-  Scene scene(map);
-  for (int i = 0; i < k; ++i)
-  {
-    if (i > 0 && options.moving_obstacles)
-    {
-      for (Obstacle& o : obstacles)
-      {
-        for (int a = 0; a < kStepAttempts; ++a)
-        {
-          const double dir = uangle(rng);
-          const Vec2 c = o.centre + uobstacle_step(rng) * Vec2(std::cos(dir), std::sin(dir));
-          if (discAllowed(*map, c, r, { positions[static_cast<std::size_t>(i)] }))
-          {
-            o.centre = c;
-            break;
-          }
-        }
-      }
-    }
-    scene.setObstacles(obstacles);
-    const Pose2& sensor = trial.sensor_poses[static_cast<std::size_t>(i)];
-    const SceneHit hit = scene.cast(sensor, options.max_range);
-    Reading reading;
-    reading.offset = options.translate ? between(trial.truth, sensor) : Pose2(0.0, 0.0, wrapAngle(i * turn));
-    reading.max_range = options.max_range;
-    reading.range = hit.distance;
-    if (std::isfinite(reading.range) && options.noise > 0.0)
-    {
-      reading.range = std::max(0.0, reading.range + noise(rng));
-    }
-    const bool is_static = hit.kind == SceneHit::Kind::Map;
-    trial.readings.push_back(reading);
-    trial.hit_static.push_back(is_static);
-    trial.static_hits += is_static ? 1 : 0;
-  }
+  drawObstacles(draw, positions, &trial);
+  takeReadings(draw, map, &trial);
   return trial;
 }
 

@@ -62,7 +62,7 @@ const std::vector<std::string>& headers()
 std::string csvHeader()
 {
   return "scene,m,n,method,trial,success_paper,success_strict,success_top1,candidates,time_ms,"
-         "sparsity_held,err_pos,err_theta";
+         "sparsity_held,err_pos,err_theta,fov_deg";
 }
 
 std::string csvRow(const BenchRow& r)
@@ -80,6 +80,7 @@ std::string csvRow(const BenchRow& r)
   {
     out << ',';
   }
+  out << ',' << format("%g", r.fov_deg);
   return out.str();
 }
 
@@ -198,58 +199,75 @@ std::string formatMarkdownTable(const std::vector<BenchSummary>& summary)
   return out.str();
 }
 
-std::string formatPaperTable(const std::vector<BenchSummary>& summary)
+namespace
 {
-  // Columns: (scene, m) in first-seen order; rows: method x metric. Counts pooled over n.
+/// The counts of one (method, scene, m) pooled over n.
+struct Pool
+{
+  int trials = 0, paper = 0, strict = 0, top1 = 0;
+  double candidates = 0.0;
+};
+
+/// The paper table's pools, its columns (scene, m) and its methods, in first-seen order.
+struct PaperPools
+{
   std::vector<std::pair<std::string, int>> columns;
   std::vector<std::string> methods;
-  struct Pool
-  {
-    int trials = 0, paper = 0, strict = 0, top1 = 0;
-    double candidates = 0.0;
-  };
   std::map<std::tuple<std::string, std::string, int>, Pool> pools;
+};
+
+PaperPools poolOverResolutions(const std::vector<BenchSummary>& summary)
+{
+  PaperPools out;
   for (const BenchSummary& s : summary)
   {
     const std::pair<std::string, int> col(s.scene, s.m);
-    if (std::find(columns.begin(), columns.end(), col) == columns.end())
+    if (std::find(out.columns.begin(), out.columns.end(), col) == out.columns.end())
     {
-      columns.push_back(col);
+      out.columns.push_back(col);
     }
-    if (std::find(methods.begin(), methods.end(), s.method) == methods.end())
+    if (std::find(out.methods.begin(), out.methods.end(), s.method) == out.methods.end())
     {
-      methods.push_back(s.method);
+      out.methods.push_back(s.method);
     }
-    Pool& p = pools[std::make_tuple(s.method, s.scene, s.m)];
+    Pool& p = out.pools[std::make_tuple(s.method, s.scene, s.m)];
     p.trials += s.trials;
     p.paper += s.success_paper;
     p.strict += s.success_strict;
     p.top1 += s.success_top1;
     p.candidates += s.mean_candidates * s.trials;
   }
+  return out;
+}
+}  // namespace
+
+std::string formatPaperTable(const std::vector<BenchSummary>& summary)
+{
+  // Columns: (scene, m) in first-seen order; rows: method x metric. Counts pooled over n.
+  const PaperPools pooled = poolOverResolutions(summary);
   std::ostringstream out;
   out << "| method | metric |";
-  for (const auto& c : columns)
+  for (const auto& c : pooled.columns)
   {
     out << ' ' << c.first << " m=" << c.second << " |";
   }
   out << "\n|---|---|";
-  for (std::size_t i = 0; i < columns.size(); ++i)
+  for (std::size_t i = 0; i < pooled.columns.size(); ++i)
   {
     out << "---:|";
   }
   out << '\n';
   const char* metrics[] = { "success %", "strict %", "top-1 %", "candidates" };
-  for (const std::string& method : methods)
+  for (const std::string& method : pooled.methods)
   {
     for (int k = 0; k < 4; ++k)
     {
       out << "| " << method << " | " << metrics[k] << " |";
-      for (const auto& c : columns)
+      for (const auto& c : pooled.columns)
       {
-        const auto it = pools.find(std::make_tuple(method, c.first, c.second));
+        const auto it = pooled.pools.find(std::make_tuple(method, c.first, c.second));
         std::string cell = "-";
-        if (it != pools.end() && it->second.trials > 0)
+        if (it != pooled.pools.end() && it->second.trials > 0)
         {
           const Pool& p = it->second;
           const int counts[] = { p.paper, p.strict, p.top1 };

@@ -1,11 +1,13 @@
 #include "fdml_localization/ros/conversions.h"
 
+#include "fdml_localization/core/geometry/cone_cast.h"
 #include "fdml_localization/core/localization/ranking.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 
 namespace fdml_localization
@@ -152,12 +154,25 @@ Eigen::Matrix3d fromCovariance6(const boost::array<double, 36>& covariance)
   return out;
 }
 
+bool fieldOfViewToHalfAngle(double field_of_view, double* half_angle)
+{
+  // float32 rounds pi up by 9e-8 rad: accept that much above pi.
+  constexpr double kFloatSlack = 1e-6;
+  if (!(field_of_view >= 0.0 && field_of_view <= core::kPi + kFloatSlack))
+  {
+    return false;
+  }
+  *half_angle = std::min(0.5 * field_of_view, core::kMaxConeHalfAngle);
+  return true;
+}
+
 fdml_localization::Reading toReadingMsg(const core::Reading& reading)
 {
   fdml_localization::Reading msg;
   msg.sensor_offset = toPose2D(reading.offset);
   msg.range = reading.range;
   msg.max_range = reading.max_range;
+  msg.field_of_view = 2.0 * reading.half_angle;
   return msg;
 }
 
@@ -167,6 +182,12 @@ core::Reading fromReadingMsg(const fdml_localization::Reading& msg)
   reading.offset = fromPose2D(msg.sensor_offset);
   reading.range = msg.range;
   reading.max_range = msg.max_range;
+  if (!fieldOfViewToHalfAngle(msg.field_of_view, &reading.half_angle))
+  {
+    std::ostringstream error;
+    error << "field_of_view: " << msg.field_of_view << " rad must be finite and in [0, pi] (0 = a ray)";
+    throw std::invalid_argument(error.str());
+  }
   return reading;
 }
 
@@ -174,9 +195,16 @@ std::vector<core::Reading> fromReadingMsgs(const std::vector<fdml_localization::
 {
   std::vector<core::Reading> out;
   out.reserve(readings.size());
-  for (const auto& msg : readings)
+  for (std::size_t i = 0; i < readings.size(); ++i)
   {
-    out.push_back(fromReadingMsg(msg));
+    try
+    {
+      out.push_back(fromReadingMsg(readings[i]));
+    }
+    catch (const std::invalid_argument& e)
+    {
+      throw std::invalid_argument("readings[" + std::to_string(i) + "]." + e.what());
+    }
   }
   return out;
 }

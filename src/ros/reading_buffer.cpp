@@ -201,6 +201,7 @@ Batch makeBatch(const std::vector<ResolvedReading>& readings)
     reading.offset = core::compose(odom_to_base, r.sensor_in_odom);
     reading.range = r.raw.range;
     reading.max_range = r.raw.max_range;
+    reading.half_angle = r.raw.half_angle;
     batch.readings.push_back(reading);
     if (r.raw.stamp > batch.newest_stamp)
     {

@@ -66,6 +66,11 @@ bool rangeToReading(const sensor_msgs::Range& msg, double received, TimedReading
     *reason = problem;
     return false;
   }
+  if (!fieldOfViewToHalfAngle(msg.field_of_view, &reading->half_angle))
+  {
+    *reason = drop_reason::kInvalidFieldOfView;
+    return false;
+  }
   reading->frame_id = msg.header.frame_id;
   reading->stamp = static_cast<std::int64_t>(msg.header.stamp.toNSec());
   reading->beam = core::Pose2();

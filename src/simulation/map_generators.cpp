@@ -213,7 +213,9 @@ PolygonMap randomPolygon(int vertices, double mean_radius, double radius_noise, 
   return PolygonMap::fromRings({ ring }, source.str());
 }
 
-PolygonMap generateBuilding(const BuildingOptions& o)
+namespace
+{
+void validateBuildingOptions(const BuildingOptions& o)
 {
   require(std::isfinite(o.wall_thickness) && o.wall_thickness >= 4.0 * kUnit && o.wall_thickness <= 1.0,
           "wall_thickness", o.wall_thickness, "[0.0004, 1] m");
@@ -232,104 +234,123 @@ PolygonMap generateBuilding(const BuildingOptions& o)
           "[2 * max(door_width + 4 * wall_thickness, 1) + corridor_width, 10000] m");
   require(o.pillar_probability >= 0.0 && o.pillar_probability <= 1.0, "pillar_probability", o.pillar_probability,
           "[0, 1]");
+}
 
-  std::mt19937_64 rng(o.seed);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  auto random_between = [&](Units lo, Units hi) { return lo + static_cast<Units>(std::floor((hi - lo) * unit(rng))); };
-  // Wall thickness a multiple of 4 units, so that half and three quarters of it are whole units.
-  const Units t = 4 * std::max<Units>(1, toUnits(o.wall_thickness / 4.0));
-  const Units h = t / 2, door_reach = 3 * t / 4;
-  const Units c = toUnits(o.corridor_width), d = toUnits(o.door_width), room = toUnits(o.room_size);
-  const Units width = toUnits(o.width), height = toUnits(o.height);
-  const Units min_room_u = std::max<Units>(d + 4 * t, toUnits(1.0));
+/// The building's plan in layout units, and the random draws that fill it.
+struct BuildingPlan
+{
+  const BuildingOptions& o;
+  std::mt19937_64 rng;
+  std::uniform_real_distribution<double> unit{ 0.0, 1.0 };
+  Units t = 0;           ///< wall thickness, a multiple of 4 units (half and 3/4 are whole units)
+  Units h = 0;           ///< half the wall thickness
+  Units door_reach = 0;  ///< how far a door opening reaches either side of its wall
+  Units c = 0, d = 0, room = 0, width = 0, height = 0, min_room_u = 0;
+  Units bands = 1;              ///< bands of [room row, corridor, room row] along y
+  Units row_h = 0;              ///< height of a row of rooms
+  std::vector<Units> block_w;   ///< widths of the blocks of rooms between vertical corridors
+  std::vector<Units> block_x0;  ///< where each block starts
+  std::vector<Rect> free_rects;
+  std::vector<Rect> pillars;
 
-  // Along y: bands of [room row, corridor, room row]; every room row touches one corridor.
-  Units bands = std::max<Units>(1, static_cast<Units>(std::llround(o.height / (2.0 * o.room_size + o.corridor_width))));
-  while (bands > 1 && (height - bands * c) / (2 * bands) < min_room_u)
+  explicit BuildingPlan(const BuildingOptions& options) : o(options), rng(options.seed)
   {
-    --bands;
+    t = 4 * std::max<Units>(1, toUnits(o.wall_thickness / 4.0));
+    h = t / 2;
+    door_reach = 3 * t / 4;
+    c = toUnits(o.corridor_width);
+    d = toUnits(o.door_width);
+    room = toUnits(o.room_size);
+    width = toUnits(o.width);
+    height = toUnits(o.height);
+    min_room_u = std::max<Units>(d + 4 * t, toUnits(1.0));
   }
-  const Units row_h = (height - bands * c) / (2 * bands);
-  require(row_h >= min_room_u, "height", o.height, "large enough for a row of rooms on each side of a corridor");
-  // Along x: blocks of rooms separated by vertical corridors that link the horizontal ones.
+
+  Units randomBetween(Units lo, Units hi)
+  {
+    return lo + static_cast<Units>(std::floor((hi - lo) * unit(rng)));
+  }
+};
+
+/// Rows of rooms along y, blocks along x separated by vertical corridors (added as free space).
+void planBandsAndBlocks(BuildingPlan& p)
+{
+  const BuildingOptions& o = p.o;
+  p.bands = std::max<Units>(1, static_cast<Units>(std::llround(o.height / (2.0 * o.room_size + o.corridor_width))));
+  while (p.bands > 1 && (p.height - p.bands * p.c) / (2 * p.bands) < p.min_room_u)
+  {
+    --p.bands;
+  }
+  p.row_h = (p.height - p.bands * p.c) / (2 * p.bands);
+  require(p.row_h >= p.min_room_u, "height", o.height, "large enough for a row of rooms on each side of a corridor");
   Units vcorr =
       std::max<Units>(1, static_cast<Units>(std::llround(o.width / (3.0 * o.room_size + o.corridor_width))) - 1);
-  while (vcorr > 1 && (width - vcorr * c) / (vcorr + 1) < min_room_u)
+  while (vcorr > 1 && (p.width - vcorr * p.c) / (vcorr + 1) < p.min_room_u)
   {
     --vcorr;
   }
-  const std::vector<Units> block_w = splitLength(width - vcorr * c, (width - vcorr * c) / (vcorr + 1), min_room_u, rng);
-  require(static_cast<Units>(block_w.size()) == vcorr + 1 &&
-              *std::min_element(block_w.begin(), block_w.end()) >= min_room_u,
+  p.block_w = splitLength(p.width - vcorr * p.c, (p.width - vcorr * p.c) / (vcorr + 1), p.min_room_u, p.rng);
+  require(static_cast<Units>(p.block_w.size()) == vcorr + 1 &&
+              *std::min_element(p.block_w.begin(), p.block_w.end()) >= p.min_room_u,
           "width", o.width, "large enough for a room on each side of a vertical corridor");
-
-  std::vector<Rect> free_rects;
-  std::vector<Rect> pillars;
-  std::vector<Units> block_x0;
   Units x = 0;
-  for (std::size_t b = 0; b < block_w.size(); ++b)
+  for (std::size_t b = 0; b < p.block_w.size(); ++b)
   {
-    block_x0.push_back(x);
-    x += block_w[b];
-    if (b + 1 < block_w.size())
+    p.block_x0.push_back(x);
+    x += p.block_w[b];
+    if (b + 1 < p.block_w.size())
     {
-      free_rects.push_back({ x + h, h, x + c - h, height - h });  // vertical corridor
-      x += c;
+      p.free_rects.push_back({ x + p.h, p.h, x + p.c - p.h, p.height - p.h });  // vertical corridor
+      x += p.c;
     }
   }
-  const Units pillar = std::max(toUnits(0.3), 2 * t);
-  const Units pillar_margin = std::max(toUnits(0.5), t);
-  for (Units band = 0; band < bands; ++band)
-  {
-    const Units y0 = band * (2 * row_h + c);
-    const Units yc0 = y0 + row_h, yc1 = yc0 + c;  // corridor of this band
-    free_rects.push_back({ h, yc0 + h, width - h, yc1 - h });
-    for (int side = 0; side < 2; ++side)
-    {
-      const Units ry0 = side == 0 ? y0 : yc1;
-      const Units ry1 = ry0 + row_h;
-      const Units wall_y = side == 0 ? yc0 : yc1;  // the wall shared with the corridor
-      for (std::size_t b = 0; b < block_w.size(); ++b)
-      {
-        const std::vector<Units> widths = splitLength(block_w[b], room, min_room_u, rng);
-        Units rx0 = block_x0[b];
-        for (std::size_t k = 0; k < widths.size(); ++k)
-        {
-          const Units rx1 = rx0 + widths[k];
-          const Rect r{ rx0 + h, ry0 + h, rx1 - h, ry1 - h };
-          free_rects.push_back(r);
-          // Door to the corridor, a wall thickness away from the room's corners.
-          const Units dx = random_between(r.x0 + t, r.x1 - t - d);
-          free_rects.push_back({ dx, wall_y - door_reach, dx + d, wall_y + door_reach });
-          // Sometimes a connecting door to the next room in the row.
-          if (k + 1 < widths.size() && unit(rng) < 0.35)
-          {
-            const Units dy = random_between(r.y0 + t, r.y1 - t - d);
-            free_rects.push_back({ rx1 - door_reach, dy, rx1 + door_reach, dy + d });
-          }
-          const Units px_room = r.x1 - r.x0 - pillar - 2 * pillar_margin;
-          const Units py_room = r.y1 - r.y0 - pillar - 2 * pillar_margin;
-          if (unit(rng) < o.pillar_probability && px_room > 0 && py_room > 0)
-          {
-            const Units px = random_between(r.x0 + pillar_margin, r.x0 + pillar_margin + px_room);
-            const Units py = random_between(r.y0 + pillar_margin, r.y0 + pillar_margin + py_room);
-            pillars.push_back({ px, py, px + pillar, py + pillar });
-          }
-          rx0 = rx1;
-        }
-      }
-    }
-  }
+}
 
-  BgMulti free_space = unionOf(free_rects);
-  if (!pillars.empty())
+/// One block's rooms in the row [ry0, ry1], each with a door to the corridor wall at wall_y,
+/// sometimes a door to the next room, sometimes a pillar.
+void addRooms(BuildingPlan& p, std::size_t block, Units ry0, Units ry1, Units wall_y)
+{
+  const Units pillar = std::max(toUnits(0.3), 2 * p.t);
+  const Units pillar_margin = std::max(toUnits(0.5), p.t);
+  const std::vector<Units> widths = splitLength(p.block_w[block], p.room, p.min_room_u, p.rng);
+  Units rx0 = p.block_x0[block];
+  for (std::size_t k = 0; k < widths.size(); ++k)
+  {
+    const Units rx1 = rx0 + widths[k];
+    const Rect r{ rx0 + p.h, ry0 + p.h, rx1 - p.h, ry1 - p.h };
+    p.free_rects.push_back(r);
+    // Door to the corridor, a wall thickness away from the room's corners.
+    const Units dx = p.randomBetween(r.x0 + p.t, r.x1 - p.t - p.d);
+    p.free_rects.push_back({ dx, wall_y - p.door_reach, dx + p.d, wall_y + p.door_reach });
+    if (k + 1 < widths.size() && p.unit(p.rng) < 0.35)
+    {
+      const Units dy = p.randomBetween(r.y0 + p.t, r.y1 - p.t - p.d);
+      p.free_rects.push_back({ rx1 - p.door_reach, dy, rx1 + p.door_reach, dy + p.d });
+    }
+    const Units px_room = r.x1 - r.x0 - pillar - 2 * pillar_margin;
+    const Units py_room = r.y1 - r.y0 - pillar - 2 * pillar_margin;
+    if (p.unit(p.rng) < p.o.pillar_probability && px_room > 0 && py_room > 0)
+    {
+      const Units px = p.randomBetween(r.x0 + pillar_margin, r.x0 + pillar_margin + px_room);
+      const Units py = p.randomBetween(r.y0 + pillar_margin, r.y0 + pillar_margin + py_room);
+      p.pillars.push_back({ px, py, px + pillar, py + pillar });
+    }
+    rx0 = rx1;
+  }
+}
+
+/// The free space (rectangles minus pillars) as one polygon with holes.
+PolygonMap assemble(const BuildingPlan& p)
+{
+  BgMulti free_space = unionOf(p.free_rects);
+  if (!p.pillars.empty())
   {
     BgMulti with_pillars;
-    bg::difference(free_space, unionOf(pillars), with_pillars);
+    bg::difference(free_space, unionOf(p.pillars), with_pillars);
     free_space = std::move(with_pillars);
   }
   std::ostringstream source;
-  source << "generateBuilding(" << o.width << " x " << o.height << ", seed " << o.seed << ")";
+  source << "generateBuilding(" << p.o.width << " x " << p.o.height << ", seed " << p.o.seed << ")";
   if (free_space.size() != 1)
   {
     throw MapError(source.str(), 0, "free space has " + std::to_string(free_space.size()) + " components, expected 1");
@@ -341,6 +362,30 @@ PolygonMap generateBuilding(const BuildingOptions& o)
     rings.push_back(toRing(inner));
   }
   return PolygonMap::fromRings(std::move(rings), source.str());
+}
+}  // namespace
+
+PolygonMap generateBuilding(const BuildingOptions& o)
+{
+  validateBuildingOptions(o);
+  BuildingPlan p(o);
+  planBandsAndBlocks(p);
+  for (Units band = 0; band < p.bands; ++band)
+  {
+    const Units y0 = band * (2 * p.row_h + p.c);
+    const Units yc0 = y0 + p.row_h, yc1 = yc0 + p.c;  // corridor of this band
+    p.free_rects.push_back({ p.h, yc0 + p.h, p.width - p.h, yc1 - p.h });
+    for (int side = 0; side < 2; ++side)
+    {
+      const Units ry0 = side == 0 ? y0 : yc1;
+      const Units wall_y = side == 0 ? yc0 : yc1;  // the wall shared with the corridor
+      for (std::size_t b = 0; b < p.block_w.size(); ++b)
+      {
+        addRooms(p, b, ry0, ry0 + p.row_h, wall_y);
+      }
+    }
+  }
+  return assemble(p);
 }
 
 }  // namespace core

@@ -1,4 +1,5 @@
 #include "fdml_localization/simulation/scenario.h"
+#include "fdml_localization/simulation/scenario_readers.h"
 
 #include <cmath>
 #include <limits>
@@ -10,8 +11,7 @@ namespace core
 {
 namespace
 {
-constexpr double kMaxCoordinate = 1e5;  // [m]
-constexpr double kMaxRate = 10000.0;    // [Hz]
+constexpr double kMaxRate = 10000.0;  // [Hz]
 
 /// Reads an optional pose {x, y, theta}; true when present and valid.
 bool readPose(FieldReader* parent, const std::string& key, Pose2* pose, std::vector<std::string>* errors)
@@ -23,47 +23,12 @@ bool readPose(FieldReader* parent, const std::string& key, Pose2* pose, std::vec
   }
   const std::size_t before = errors->size();
   FieldReader r(*node, parent->pathOf(key), errors);
-  r.number("x", &pose->x, -kMaxCoordinate, kMaxCoordinate);
-  r.number("y", &pose->y, -kMaxCoordinate, kMaxCoordinate);
+  r.number("x", &pose->x, -kMaxScenarioCoordinate, kMaxScenarioCoordinate);
+  r.number("y", &pose->y, -kMaxScenarioCoordinate, kMaxScenarioCoordinate);
   r.number("theta", &pose->theta, -2.0 * kTwoPi, 2.0 * kTwoPi);
   r.finish();
   pose->theta = wrapAngle(pose->theta);
   return errors->size() == before;
-}
-
-/// Reads a list of [x, y] points.
-std::vector<Vec2> readPoints(FieldReader* parent, const std::string& key, std::vector<std::string>* errors)
-{
-  std::vector<Vec2> points;
-  const ParamValue* node = parent->child(key);
-  if (node == nullptr)
-  {
-    return points;
-  }
-  const std::string path = parent->pathOf(key);
-  if (!node->isList())
-  {
-    errors->push_back(path + ": must be a list of [x, y] points, got " + ParamValue::typeName(node->type()));
-    return points;
-  }
-  for (std::size_t i = 0; i < node->items().size(); ++i)
-  {
-    const ParamValue& item = node->items()[i];
-    const std::string item_path = path + "[" + std::to_string(i) + "]";
-    if (!item.isList() || item.items().size() != 2 || !item.items()[0].isNumber() || !item.items()[1].isNumber())
-    {
-      errors->push_back(item_path + ": must be a point [x, y] of two numbers");
-      continue;
-    }
-    const Vec2 p(item.items()[0].asDouble(), item.items()[1].asDouble());
-    if (!p.allFinite() || p.cwiseAbs().maxCoeff() > kMaxCoordinate)
-    {
-      errors->push_back(item_path + ": coordinates must be finite and within 1e5 m");
-      continue;
-    }
-    points.push_back(p);
-  }
-  return points;
 }
 
 void readFrames(FieldReader* root, FramesConfig* frames, std::vector<std::string>* errors)
@@ -212,76 +177,6 @@ void readOdometry(FieldReader* root, OdometryConfig* odom, std::vector<std::stri
   r.number("translation_noise", &odom->translation_noise, 0.0, 10.0);
   r.number("rotation_noise", &odom->rotation_noise, 0.0, 10.0);
   r.finish();
-}
-
-void readObstacles(FieldReader* root, std::vector<ObstacleGroupConfig>* groups, std::vector<std::string>* errors)
-{
-  const ParamValue* node = root->child("obstacles");
-  if (node == nullptr)
-  {
-    return;
-  }
-  if (!node->isList())
-  {
-    root->error("obstacles",
-                std::string("must be a list of obstacle groups, got ") + ParamValue::typeName(node->type()));
-    return;
-  }
-  for (std::size_t i = 0; i < node->items().size(); ++i)
-  {
-    ObstacleGroupConfig g;
-    FieldReader r(node->items()[i], root->pathOf("obstacles") + "[" + std::to_string(i) + "]", errors);
-    std::int64_t count = g.count;
-    if (r.integer("count", &count, 0, 10000))
-    {
-      g.count = static_cast<int>(count);
-    }
-    std::string shape = "disc";
-    r.string("shape", &shape, false, { "disc", "polygon" });
-    g.polygon = shape == "polygon";
-    r.number("radius", &g.radius, 1e-3, 100.0);
-    g.vertices = readPoints(&r, "vertices", errors);
-    if (g.polygon && (g.vertices.size() < 3 || std::abs(signedArea(g.vertices)) < 1e-9))
-    {
-      r.error("vertices", "a polygon obstacle needs at least 3 vertices enclosing a positive area");
-    }
-    if (!g.polygon && !g.vertices.empty())
-    {
-      r.error("vertices", "only allowed with shape 'polygon'");
-    }
-    std::string motion = "static";
-    if (r.string("motion", &motion, false, { "static", "bounce", "waypoints", "random_walk" }))
-    {
-      g.motion = motion == "static"    ? ObstacleMotion::Static :
-                 motion == "bounce"    ? ObstacleMotion::Bounce :
-                 motion == "waypoints" ? ObstacleMotion::Waypoints :
-                                         ObstacleMotion::RandomWalk;
-    }
-    r.number("speed", &g.speed, 0.0, 20.0);
-    r.number("turn_sigma", &g.turn_sigma, 0.0, 100.0);
-    g.waypoints = readPoints(&r, "waypoints", errors);
-    g.positions = readPoints(&r, "positions", errors);
-    std::int64_t seed = 0;
-    if (r.integer("seed", &seed, 0, std::numeric_limits<std::int64_t>::max()))
-    {
-      g.seed = static_cast<std::uint64_t>(seed);
-    }
-    if (g.motion == ObstacleMotion::Waypoints && g.waypoints.size() < 2)
-    {
-      r.error("waypoints", "motion 'waypoints' needs at least 2 waypoints");
-    }
-    if (g.motion != ObstacleMotion::Waypoints && !g.waypoints.empty())
-    {
-      r.error("waypoints", "only allowed with motion 'waypoints'");
-    }
-    if (!g.positions.empty() && static_cast<int>(g.positions.size()) != g.count)
-    {
-      r.error("positions",
-              "has " + std::to_string(g.positions.size()) + " points but count is " + std::to_string(g.count));
-    }
-    r.finish();
-    groups->push_back(g);
-  }
 }
 
 void readVisualization(FieldReader* root, VisualizationConfig* vis, std::vector<std::string>* errors)

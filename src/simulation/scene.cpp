@@ -7,6 +7,25 @@ namespace fdml_localization
 {
 namespace core
 {
+namespace
+{
+/// Makes @p hit the nearest obstacle within @p max_range when one is nearer than its map hit.
+template <typename Distance>
+void nearestObstacle(const std::vector<Obstacle>& obstacles, double max_range, Distance&& distance, SceneHit* hit)
+{
+  for (std::size_t i = 0; i < obstacles.size(); ++i)
+  {
+    const double t = distance(obstacles[i]);
+    if (t <= max_range && t < hit->distance)
+    {
+      hit->kind = SceneHit::Kind::Obstacle;
+      hit->distance = t;
+      hit->obstacle = static_cast<int>(i);
+    }
+  }
+}
+}  // namespace
+
 Obstacle Obstacle::disc(const Vec2& centre, double radius)
 {
   Obstacle o;
@@ -79,6 +98,25 @@ double Obstacle::castDistance(const Vec2& origin, const Vec2& dir) const
   return best;
 }
 
+double Obstacle::sectorDistance(const Sector& sector) const
+{
+  if (shape == Shape::Disc)
+  {
+    return sectorCircleDistance(sector, centre, radius);
+  }
+  if (pointInRing(sector.origin, vertices))
+  {
+    return 0.0;
+  }
+  double best = kInf;
+  const std::size_t n = vertices.size();
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    best = std::min(best, sectorSegmentDistance(sector, Segment{ vertices[i], vertices[(i + 1) % n] }));
+  }
+  return best;
+}
+
 Scene::Scene(std::shared_ptr<const MapRayCaster> map) : map_(std::move(map))
 {
   if (!map_)
@@ -98,16 +136,27 @@ SceneHit Scene::cast(const Pose2& sensor, double max_range) const
     hit.kind = SceneHit::Kind::Map;
     hit.distance = hit.map_distance;
   }
-  for (std::size_t i = 0; i < obstacles_.size(); ++i)
+  nearestObstacle(
+      obstacles_, max_range, [&](const Obstacle& o) { return o.castDistance(origin, dir); }, &hit);
+  return hit;
+}
+
+SceneHit Scene::castCone(const Pose2& sensor, double half_angle, double max_range) const
+{
+  if (half_angle == 0.0)
   {
-    const double t = obstacles_[i].castDistance(origin, dir);
-    if (t <= max_range && t < hit.distance)
-    {
-      hit.kind = SceneHit::Kind::Obstacle;
-      hit.distance = t;
-      hit.obstacle = static_cast<int>(i);
-    }
+    return cast(sensor, max_range);
   }
+  SceneHit hit;
+  hit.map_distance = coneRange(*map_, sensor, half_angle, max_range);
+  if (hit.map_distance <= max_range)
+  {
+    hit.kind = SceneHit::Kind::Map;
+    hit.distance = hit.map_distance;
+  }
+  const Sector sector = Sector::around(sensor, half_angle);
+  nearestObstacle(
+      obstacles_, max_range, [&](const Obstacle& o) { return o.sectorDistance(sector); }, &hit);
   return hit;
 }
 

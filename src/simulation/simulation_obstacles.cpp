@@ -120,30 +120,72 @@ bool Simulation::obstacleFits(std::size_t index, const Vec2& position, const Vec
   return true;
 }
 
-bool Simulation::placeObstacles(std::vector<std::string>* errors)
+bool Simulation::obstacleApart(std::size_t index, const Vec2& p) const
 {
-  const std::size_t before = errors->size();
+  // Obstacles do not start overlapping each other (bounding circles).
+  for (std::size_t j = 0; j < index; ++j)
+  {
+    if ((obstacles_[j].position - p).norm() < radii_[j] + radii_[index] + config_.clearance)
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+bool Simulation::placeObstacle(std::size_t g, int k, ObstacleState* state, std::string* error)
+{
+  const ObstacleGroupConfig& group = config_.obstacles[g];
+  const std::string path = "obstacles[" + std::to_string(g) + "]";
+  const std::size_t index = obstacles_.size();
+  const Vec2 robot = true_pose_.position();
+  const auto fits = [&](const Vec2& p) { return obstacleFits(index, p, robot) && obstacleApart(index, p); };
+  if (!group.positions.empty())
+  {
+    state->position = group.positions[static_cast<std::size_t>(k)];
+    *error = path + ".positions[" + std::to_string(k) + "]: the obstacle does not fit there (wall, robot or another " +
+             "obstacle)";
+    return fits(state->position);
+  }
+  if (group.motion == ObstacleMotion::Waypoints)
+  {
+    for (int t = 0; t < 200; ++t)
+    {
+      const double f = std::fmod((k + t / 200.0) / group.count, 1.0);
+      state->position = pointOnLoop(group.waypoints, f, &state->next_waypoint);
+      if (fits(state->position))
+      {
+        return true;
+      }
+    }
+    *error = path + ".waypoints: no room on the loop for obstacle " + std::to_string(k + 1) + " of " +
+             std::to_string(group.count);
+    return false;
+  }
   const Box2& bounds = map_->map().bounds();
   std::uniform_real_distribution<double> ux(bounds.min.x(), bounds.max.x());
   std::uniform_real_distribution<double> uy(bounds.min.y(), bounds.max.y());
-  const Vec2 robot = true_pose_.position();
-  // Obstacles do not start overlapping each other (bounding circles).
-  auto apart = [this](std::size_t index, const Vec2& p) {
-    for (std::size_t j = 0; j < index; ++j)
+  std::mt19937_64& rng = group_rngs_[g];
+  for (int t = 0; t < kPlacementTries; ++t)
+  {
+    state->position = Vec2(ux(rng), uy(rng));
+    if (fits(state->position))
     {
-      if ((obstacles_[j].position - p).norm() < radii_[j] + radii_[index] + config_.clearance)
-      {
-        return false;
-      }
+      return true;
     }
-    return true;
-  };
+  }
+  *error = path + ".count: could not place obstacle " + std::to_string(k + 1) + " of " + std::to_string(group.count) +
+           " in free space (too many or too large for the map)";
+  return false;
+}
+
+bool Simulation::placeObstacles(std::vector<std::string>* errors)
+{
+  const std::size_t before = errors->size();
   for (std::size_t g = 0; g < config_.obstacles.size(); ++g)
   {
     const ObstacleGroupConfig& group = config_.obstacles[g];
-    const std::string path = "obstacles[" + std::to_string(g) + "]";
     group_rngs_.emplace_back(group.seed != 0 ? group.seed : config_.seed * 1000003ULL + g + 1);
-    std::mt19937_64& rng = group_rngs_.back();
     double bounding = group.radius;
     if (group.polygon)
     {
@@ -155,56 +197,19 @@ bool Simulation::placeObstacles(std::vector<std::string>* errors)
     }
     for (int k = 0; k < group.count; ++k)
     {
-      const std::size_t index = obstacles_.size();
       shapes_.push_back(group.polygon ? group.vertices : Ring());
       radii_.push_back(bounding);
       ObstacleState state;
       state.group = static_cast<int>(g);
-      bool placed = false;
-      if (!group.positions.empty())
+      std::string error;
+      if (!placeObstacle(g, k, &state, &error))
       {
-        state.position = group.positions[static_cast<std::size_t>(k)];
-        placed = obstacleFits(index, state.position, robot) && apart(index, state.position);
-        if (!placed)
-        {
-          errors->push_back(path + ".positions[" + std::to_string(k) +
-                            "]: the obstacle does not fit there (wall, robot or another obstacle)");
-        }
-      }
-      else if (group.motion == ObstacleMotion::Waypoints)
-      {
-        for (int t = 0; t < 200 && !placed; ++t)
-        {
-          const double f = std::fmod((k + t / 200.0) / group.count, 1.0);
-          state.position = pointOnLoop(group.waypoints, f, &state.next_waypoint);
-          placed = obstacleFits(index, state.position, robot) && apart(index, state.position);
-        }
-        if (!placed)
-        {
-          errors->push_back(path + ".waypoints: no room on the loop for obstacle " + std::to_string(k + 1) + " of " +
-                            std::to_string(group.count));
-        }
-      }
-      else
-      {
-        for (int t = 0; t < kPlacementTries && !placed; ++t)
-        {
-          state.position = Vec2(ux(rng), uy(rng));
-          placed = obstacleFits(index, state.position, robot) && apart(index, state.position);
-        }
-        if (!placed)
-        {
-          errors->push_back(path + ".count: could not place obstacle " + std::to_string(k + 1) + " of " +
-                            std::to_string(group.count) + " in free space (too many or too large for the map)");
-        }
-      }
-      if (!placed)
-      {
+        errors->push_back(error);
         break;
       }
       if (group.motion == ObstacleMotion::Bounce || group.motion == ObstacleMotion::RandomWalk)
       {
-        state.velocity = group.speed * randomDirection(&rng);
+        state.velocity = group.speed * randomDirection(&group_rngs_[g]);
       }
       obstacles_.push_back(state);
     }
@@ -235,65 +240,74 @@ void Simulation::moveObstacle(std::size_t index)
 {
   ObstacleState& o = obstacles_[index];
   const ObstacleGroupConfig& group = config_.obstacles[static_cast<std::size_t>(o.group)];
-  std::mt19937_64& rng = group_rngs_[static_cast<std::size_t>(o.group)];
-  const Vec2 robot = true_pose_.position();
   switch (group.motion)
   {
     case ObstacleMotion::Static:
       return;
-    case ObstacleMotion::Waypoints: {
-      const Vec2 d = group.waypoints[o.next_waypoint] - o.position;
-      const double distance = d.norm();
-      const double advance = std::min(distance, group.speed * dt_);
-      const Vec2 target = distance > 0.0 ? Vec2(o.position + d * (advance / distance)) : o.position;
-      if (obstacleFits(index, target, robot))
-      {
-        o.velocity = (target - o.position) / dt_;
-        o.position = target;
-        o.blocked_time = 0.0;
-        if (distance <= group.speed * dt_)
-        {
-          const std::size_t n = group.waypoints.size();
-          o.next_waypoint = stepIndex(o.next_waypoint, o.direction, n);
-        }
-      }
-      else
-      {
-        // Blocked by the robot: wait, and after a while turn back along the loop.
-        o.velocity = Vec2::Zero();
-        o.blocked_time += dt_;
-        if (o.blocked_time >= kGiveWayTime)
-        {
-          const std::size_t n = group.waypoints.size();
-          o.next_waypoint = stepIndex(o.next_waypoint, -o.direction, n);
-          o.direction = -o.direction;
-          o.blocked_time = 0.0;
-        }
-      }
+    case ObstacleMotion::Waypoints:
+      moveAlongWaypoints(index);
       return;
-    }
     case ObstacleMotion::RandomWalk: {
       std::normal_distribution<double> turn(0.0, group.turn_sigma * std::sqrt(dt_));
-      const double a = turn(rng);
+      const double a = turn(group_rngs_[static_cast<std::size_t>(o.group)]);
       o.velocity = Eigen::Rotation2Dd(a) * o.velocity;
-      break;
+      moveOrReflect(index);
+      return;
     }
     case ObstacleMotion::Bounce:
-      break;
+      moveOrReflect(index);
+      return;
   }
+}
+
+void Simulation::moveAlongWaypoints(std::size_t index)
+{
+  ObstacleState& o = obstacles_[index];
+  const ObstacleGroupConfig& group = config_.obstacles[static_cast<std::size_t>(o.group)];
+  const std::size_t n = group.waypoints.size();
+  const Vec2 d = group.waypoints[o.next_waypoint] - o.position;
+  const double distance = d.norm();
+  const double advance = std::min(distance, group.speed * dt_);
+  const Vec2 target = distance > 0.0 ? Vec2(o.position + d * (advance / distance)) : o.position;
+  if (obstacleFits(index, target, true_pose_.position()))
+  {
+    o.velocity = (target - o.position) / dt_;
+    o.position = target;
+    o.blocked_time = 0.0;
+    if (distance <= group.speed * dt_)
+    {
+      o.next_waypoint = stepIndex(o.next_waypoint, o.direction, n);
+    }
+    return;
+  }
+  // Blocked by the robot: wait, and after a while turn back along the loop.
+  o.velocity = Vec2::Zero();
+  o.blocked_time += dt_;
+  if (o.blocked_time >= kGiveWayTime)
+  {
+    o.next_waypoint = stepIndex(o.next_waypoint, -o.direction, n);
+    o.direction = -o.direction;
+    o.blocked_time = 0.0;
+  }
+}
+
+void Simulation::moveOrReflect(std::size_t index)
+{
   // Bounce and random walk: move on, else reflect off whatever is in the way.
+  ObstacleState& o = obstacles_[index];
   const Vec2 v = o.velocity;
   for (const Vec2& candidate : { v, Vec2(-v.x(), v.y()), Vec2(v.x(), -v.y()), Vec2(-v) })
   {
     const Vec2 target = o.position + candidate * dt_;
-    if (obstacleFits(index, target, robot))
+    if (obstacleFits(index, target, true_pose_.position()))
     {
       o.velocity = candidate;
       o.position = target;
       return;
     }
   }
-  o.velocity = group.speed * randomDirection(&rng);  // stuck: try another direction next step
+  const ObstacleGroupConfig& group = config_.obstacles[static_cast<std::size_t>(o.group)];
+  o.velocity = group.speed * randomDirection(&group_rngs_[static_cast<std::size_t>(o.group)]);  // stuck: try another
 }
 
 }  // namespace core

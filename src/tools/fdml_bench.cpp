@@ -11,7 +11,9 @@
 #include <cstdlib>
 #include <ctime>
 #include <fstream>
+#include <functional>
 #include <iostream>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -30,11 +32,13 @@ const char* kUsage = "usage: fdml_bench --map PATH[:SCALE] [--map ...] [--random
                      "                  --resolution 50,100,150,200 --trials 50 [--seed 1]\n"
                      "                  [--method robust|paper|baseline[,...]] [--engine voxel|adaptive] [--threads "
                      "J]\n"
-                     "                  [--moving-obstacles] [--translate] [--noise SIGMA] [--no-return "
-                     "constraint|weak|drop]\n"
+                     "                  [--moving-obstacles] [--translate] [--noise SIGMA] [--fov DEG]\n"
+                     "                  [--no-return constraint|weak|drop]\n"
                      "                  [--csv FILE] [--markdown FILE]\n"
                      "Scene names: the map file's stem, random<VERTICES> for --random; a SCALE other than 1\n"
-                     "appends _x<SCALE> (checkpoint.poly:0.25 -> checkpoint_x0.25, --random 70:2 -> random70_x2).\n";
+                     "appends _x<SCALE> (checkpoint.poly:0.25 -> checkpoint_x0.25, --random 70:2 -> random70_x2).\n"
+                     "--fov DEG gives every reading a cone of that full field of view [deg] in [0, 180]: the\n"
+                     "nearest point of the map or a disc within +-DEG/2 (0, the default, = rays).\n";
 
 struct UsageError : std::runtime_error
 {
@@ -134,138 +138,139 @@ struct Cli
   std::string markdown;
 };
 
-Cli parseArgs(int argc, char** argv)
+std::vector<core::Method> parseMethods(const std::string& text)
+{
+  std::vector<core::Method> methods;
+  for (const std::string& m : splitList(text))
+  {
+    try
+    {
+      methods.push_back(core::parseMethod(m));
+    }
+    catch (const std::invalid_argument&)
+    {
+      throw UsageError("--method: '" + m + "' is not one of robust, paper, baseline");
+    }
+  }
+  return methods;
+}
+
+core::Engine parseEngineFlag(const std::string& e)
+{
+  try
+  {
+    return core::parseEngine(e);
+  }
+  catch (const std::invalid_argument&)
+  {
+    throw UsageError("--engine: '" + e + "' is not one of voxel, adaptive");
+  }
+}
+
+core::NoReturnPolicy parseNoReturnFlag(const std::string& v)
+{
+  try
+  {
+    return core::parseNoReturn(v);
+  }
+  catch (const std::invalid_argument&)
+  {
+    throw UsageError("--no-return: '" + v + "' is not one of constraint, weak, drop");
+  }
+}
+
+std::uint64_t parseSeed(const std::string& text)
+{
+  const int seed = core::parseInteger(text, "--seed");
+  if (seed < 0)
+  {
+    throw UsageError("--seed must be >= 0");
+  }
+  return static_cast<std::uint64_t>(seed);
+}
+
+/// --fov DEG: every reading's full field of view; the protocol takes half of it in radians
+/// (validated there, in [0, pi/2]).
+double parseFov(const std::string& text)
+{
+  const double degrees = core::parseNumber(text, "--fov");
+  if (!(degrees >= 0.0 && degrees <= 180.0))
+  {
+    throw UsageError("--fov: " + text + " must be in [0, 180] degrees (0 = rays)");
+  }
+  return 0.5 * degrees * core::kPi / 180.0;
+}
+
+/// The flags that take a value, each storing it into @p cli.
+std::map<std::string, std::function<void(const std::string&)>> valueFlags(Cli& cli)
+{
+  core::BenchConfig& c = cli.config;
+  core::ProtocolOptions& p = c.protocol;
+  return {
+    { "--map", [&cli](const std::string& v) { cli.maps.push_back(v); } },
+    { "--random", [&cli](const std::string& v) { cli.randoms.push_back(v); } },
+    { "--obstacles", [&c](const std::string& v) { c.obstacles = parseIntList(v, "--obstacles"); } },
+    { "--radius", [&p](const std::string& v) { p.obstacle_radius = core::parseNumber(v, "--radius"); } },
+    { "--k", [&p](const std::string& v) { p.readings = core::parseInteger(v, "--k"); } },
+    { "--min-inliers",
+      [&c](const std::string& v) { c.min_inliers = v == "auto" ? 0 : core::parseInteger(v, "--min-inliers"); } },
+    { "--resolution", [&c](const std::string& v) { c.resolutions = parseIntList(v, "--resolution"); } },
+    { "--trials", [&c](const std::string& v) { c.trials = core::parseInteger(v, "--trials"); } },
+    { "--seed", [&c](const std::string& v) { c.seed = parseSeed(v); } },
+    { "--method",
+      [&c](const std::string& v) {
+        const std::vector<core::Method> methods = parseMethods(v);
+        c.methods.insert(c.methods.end(), methods.begin(), methods.end());
+      } },
+    { "--engine", [&c](const std::string& v) { c.engine = parseEngineFlag(v); } },
+    { "--threads", [&c](const std::string& v) { c.threads = core::parseInteger(v, "--threads"); } },
+    { "--noise", [&p](const std::string& v) { p.noise = core::parseNumber(v, "--noise"); } },
+    { "--fov", [&p](const std::string& v) { p.half_angle = parseFov(v); } },
+    { "--no-return", [&c](const std::string& v) { c.no_return = parseNoReturnFlag(v); } },
+    { "--csv", [&cli](const std::string& v) { cli.csv = v; } },
+    { "--markdown", [&cli](const std::string& v) { cli.markdown = v; } },
+  };
+}
+
+/// Parses the command line; sets @p help (and nothing else) on --help.
+Cli parseArgs(int argc, char** argv, bool* help)
 {
   Cli cli;
-  core::BenchConfig& c = cli.config;
-  c.methods.clear();
+  cli.config.methods.clear();
+  const auto flags = valueFlags(cli);
   for (int i = 1; i < argc; ++i)
   {
     const std::string flag = argv[i];
-    const auto value = [&]() -> std::string {
-      if (i + 1 >= argc)
-      {
-        throw UsageError(flag + " needs a value");
-      }
-      return argv[++i];
-    };
+    const auto it = flags.find(flag);
     if (flag == "--help" || flag == "-h")
     {
-      std::cout << kUsage;
-      std::exit(0);
+      *help = true;
+      return cli;
     }
-    else if (flag == "--map")
+    if (flag == "--moving-obstacles")
     {
-      cli.maps.push_back(value());
-    }
-    else if (flag == "--random")
-    {
-      cli.randoms.push_back(value());
-    }
-    else if (flag == "--obstacles")
-    {
-      c.obstacles = parseIntList(value(), flag);
-    }
-    else if (flag == "--radius")
-    {
-      c.protocol.obstacle_radius = core::parseNumber(value(), flag);
-    }
-    else if (flag == "--k")
-    {
-      c.protocol.readings = core::parseInteger(value(), flag);
-    }
-    else if (flag == "--min-inliers")
-    {
-      const std::string v = value();
-      c.min_inliers = v == "auto" ? 0 : core::parseInteger(v, flag);
-    }
-    else if (flag == "--resolution")
-    {
-      c.resolutions = parseIntList(value(), flag);
-    }
-    else if (flag == "--trials")
-    {
-      c.trials = core::parseInteger(value(), flag);
-    }
-    else if (flag == "--seed")
-    {
-      const int seed = core::parseInteger(value(), flag);
-      if (seed < 0)
-      {
-        throw UsageError("--seed must be >= 0");
-      }
-      c.seed = static_cast<std::uint64_t>(seed);
-    }
-    else if (flag == "--method")
-    {
-      for (const std::string& m : splitList(value()))
-      {
-        try
-        {
-          c.methods.push_back(core::parseMethod(m));
-        }
-        catch (const std::invalid_argument&)
-        {
-          throw UsageError("--method: '" + m + "' is not one of robust, paper, baseline");
-        }
-      }
-    }
-    else if (flag == "--engine")
-    {
-      const std::string e = value();
-      try
-      {
-        c.engine = core::parseEngine(e);
-      }
-      catch (const std::invalid_argument&)
-      {
-        throw UsageError("--engine: '" + e + "' is not one of voxel, adaptive");
-      }
-    }
-    else if (flag == "--no-return")
-    {
-      const std::string v = value();
-      try
-      {
-        c.no_return = core::parseNoReturn(v);
-      }
-      catch (const std::invalid_argument&)
-      {
-        throw UsageError("--no-return: '" + v + "' is not one of constraint, weak, drop");
-      }
-    }
-    else if (flag == "--threads")
-    {
-      c.threads = core::parseInteger(value(), flag);
-    }
-    else if (flag == "--moving-obstacles")
-    {
-      c.protocol.moving_obstacles = true;
+      cli.config.protocol.moving_obstacles = true;
     }
     else if (flag == "--translate")
     {
-      c.protocol.translate = true;
+      cli.config.protocol.translate = true;
     }
-    else if (flag == "--noise")
-    {
-      c.protocol.noise = core::parseNumber(value(), flag);
-    }
-    else if (flag == "--csv")
-    {
-      cli.csv = value();
-    }
-    else if (flag == "--markdown")
-    {
-      cli.markdown = value();
-    }
-    else
+    else if (it == flags.end())
     {
       throw UsageError("unknown option '" + flag + "'");
     }
+    else if (i + 1 >= argc)
+    {
+      throw UsageError(flag + " needs a value");
+    }
+    else
+    {
+      it->second(argv[++i]);
+    }
   }
-  if (c.methods.empty())
+  if (cli.config.methods.empty())
   {
-    c.methods.push_back(core::Method::Robust);
+    cli.config.methods.push_back(core::Method::Robust);
   }
   return cli;
 }
@@ -287,6 +292,79 @@ std::string utcNow()
   std::strftime(buf, sizeof(buf), "%Y-%m-%d %H:%M:%S UTC", std::gmtime(&now));
   return buf;
 }
+
+/// Parses and validates the command line into @p cli (scenes loaded); false on --help.
+bool setUp(int argc, char** argv, Cli* cli)
+{
+  bool help = false;
+  *cli = parseArgs(argc, argv, &help);
+  if (help)
+  {
+    return false;
+  }
+  for (const std::string& spec : cli->maps)
+  {
+    cli->config.scenes.push_back(mapScene(spec));
+  }
+  for (const std::string& spec : cli->randoms)
+  {
+    cli->config.scenes.push_back(randomScene(spec, cli->config.seed));
+  }
+  const std::vector<std::string> issues = core::validate(cli->config);
+  if (!issues.empty())
+  {
+    std::string msg = "invalid options:";
+    for (const std::string& s : issues)
+    {
+      msg += "\n  " + s;
+    }
+    throw UsageError(msg);
+  }
+  return true;
+}
+
+void writeMarkdown(const Cli& cli, const std::string& command, const std::string& started,
+                   const std::vector<core::BenchSummary>& summary)
+{
+  std::ofstream md(cli.markdown);
+  if (!md)
+  {
+    throw std::runtime_error("--markdown: cannot write '" + cli.markdown + "'");
+  }
+  md << "Command: `" << command << "`  \nStarted: " << started << ", finished: " << utcNow()
+     << "  \nSparsity k' = " << core::sparsityKPrime(cli.config) << "\n\n"
+     << core::formatMarkdownTable(summary) << "\nPaper-style (pooled over n):\n\n"
+     << core::formatPaperTable(summary);
+}
+
+void run(const Cli& cli, const std::string& command)
+{
+  std::ofstream csv;
+  if (!cli.csv.empty())
+  {
+    csv.open(cli.csv);
+    if (!csv)
+    {
+      throw std::runtime_error("--csv: cannot write '" + cli.csv + "'");
+    }
+    csv << core::csvHeader() << '\n' << std::flush;
+  }
+  const auto on_row = [&csv](const core::BenchRow& row) {
+    if (csv.is_open())
+    {
+      csv << core::csvRow(row) << '\n' << std::flush;
+    }
+  };
+  const std::string started = utcNow();
+  const core::BenchRun result = core::runBenchmark(cli.config, on_row, &std::cerr);
+  const std::vector<core::BenchSummary> summary = core::summarize(result.rows, result.tables);
+  std::cout << core::formatTable(summary) << "\nPaper-style table (success pooled over n):\n"
+            << core::formatPaperTable(summary);
+  if (!cli.markdown.empty())
+  {
+    writeMarkdown(cli, command, started, summary);
+  }
+}
 }  // namespace
 
 int main(int argc, char** argv)
@@ -294,24 +372,10 @@ int main(int argc, char** argv)
   Cli cli;
   try
   {
-    cli = parseArgs(argc, argv);
-    for (const std::string& spec : cli.maps)
+    if (!setUp(argc, argv, &cli))
     {
-      cli.config.scenes.push_back(mapScene(spec));
-    }
-    for (const std::string& spec : cli.randoms)
-    {
-      cli.config.scenes.push_back(randomScene(spec, cli.config.seed));
-    }
-    const std::vector<std::string> issues = core::validate(cli.config);
-    if (!issues.empty())
-    {
-      std::string msg = "invalid options:";
-      for (const std::string& s : issues)
-      {
-        msg += "\n  " + s;
-      }
-      throw UsageError(msg);
+      std::cout << kUsage;
+      return 0;
     }
   }
   catch (const std::exception& e)
@@ -319,42 +383,9 @@ int main(int argc, char** argv)
     std::cerr << "fdml_bench: " << e.what() << "\n" << kUsage;
     return 2;
   }
-
   try
   {
-    std::ofstream csv;
-    if (!cli.csv.empty())
-    {
-      csv.open(cli.csv);
-      if (!csv)
-      {
-        throw std::runtime_error("--csv: cannot write '" + cli.csv + "'");
-      }
-      csv << core::csvHeader() << '\n' << std::flush;
-    }
-    const auto on_row = [&csv](const core::BenchRow& row) {
-      if (csv.is_open())
-      {
-        csv << core::csvRow(row) << '\n' << std::flush;
-      }
-    };
-    const std::string started = utcNow();
-    const core::BenchRun run = core::runBenchmark(cli.config, on_row, &std::cerr);
-    const std::vector<core::BenchSummary> summary = core::summarize(run.rows, run.tables);
-    std::cout << core::formatTable(summary) << "\nPaper-style table (success pooled over n):\n"
-              << core::formatPaperTable(summary);
-    if (!cli.markdown.empty())
-    {
-      std::ofstream md(cli.markdown);
-      if (!md)
-      {
-        throw std::runtime_error("--markdown: cannot write '" + cli.markdown + "'");
-      }
-      md << "Command: `" << commandLine(argc, argv) << "`  \nStarted: " << started << ", finished: " << utcNow()
-         << "  \nSparsity k' = " << core::sparsityKPrime(cli.config) << "\n\n"
-         << core::formatMarkdownTable(summary) << "\nPaper-style (pooled over n):\n\n"
-         << core::formatPaperTable(summary);
-    }
+    run(cli, commandLine(argc, argv));
   }
   catch (const std::exception& e)
   {

@@ -6,9 +6,11 @@
 //                 [--cache-dir DIR] [--theta-resolution N] [--max-candidates M] [--max-range R]
 //                 [--verbose] [--no-return constraint|weak|drop] READINGS.csv
 //
-// READINGS.csv: header "gx,gy,gtheta,d" (optionally ",max_range"), one reading per line
+// READINGS.csv: header "gx,gy,gtheta,d" (optionally ",max_range", then optionally ",fov": the
+// sensor's full field of view [deg], 0 = a ray), one reading per line
 // [m, rad]; d may be "inf" (no return within max_range). Prints "rank,x,y,theta,inliers,rms"
 // and one candidate per line, best first; exit 0 (also with no candidate), 2 on bad input.
+#include "fdml_localization/core/geometry/cone_cast.h"
 #include "fdml_localization/core/localization/localizer.h"
 #include "fdml_localization/core/map/grid/grid_tolerances.h"
 #include "fdml_localization/core/map/map_io.h"
@@ -61,6 +63,39 @@ std::vector<std::string> splitCsv(const std::string& line)
   return fields;
 }
 
+/// The readings header: "gx,gy,gtheta,d", then optionally ",max_range", then optionally ",fov".
+void parseHeader(const std::string& header, const std::string& where, bool* has_max_range, bool* has_fov)
+{
+  const std::string base = "gx,gy,gtheta,d";
+  for (const bool max_range : { false, true })
+  {
+    for (const bool fov : { false, true })
+    {
+      if (header == base + (max_range ? ",max_range" : "") + (fov ? ",fov" : ""))
+      {
+        *has_max_range = max_range;
+        *has_fov = fov;
+        return;
+      }
+    }
+  }
+  throw UsageError(where +
+                   ": expected the header 'gx,gy,gtheta,d' (optionally ',max_range', then optionally ',fov'), got '" +
+                   header + "'");
+}
+
+/// The fov column: the sensor's full field of view [deg] in [0, 180] (0 = a ray); the reading's
+/// cone half-angle [rad].
+double parseFovColumn(const std::string& field, const std::string& where)
+{
+  const double degrees = core::parseNumber(field, where + ": fov", true);
+  if (!(degrees >= 0.0 && degrees <= 180.0))
+  {
+    throw UsageError(where + ": fov must be in [0, 180] degrees (the full field of view; 0 = a ray), got " + field);
+  }
+  return std::min(0.5 * degrees * core::kPi / 180.0, core::kMaxConeHalfAngle);
+}
+
 std::vector<core::Reading> readCsv(const std::string& path, double default_max_range)
 {
   std::ifstream in(path);
@@ -72,6 +107,7 @@ std::vector<core::Reading> readCsv(const std::string& path, double default_max_r
   int line_no = 0;
   bool have_header = false;
   bool has_max_range = false;
+  bool has_fov = false;
   std::vector<core::Reading> readings;
   while (std::getline(in, line))
   {
@@ -85,22 +121,11 @@ std::vector<core::Reading> readCsv(const std::string& path, double default_max_r
     const std::vector<std::string> fields = splitCsv(t);
     if (!have_header)
     {
-      if (t == "gx,gy,gtheta,d")
-      {
-        has_max_range = false;
-      }
-      else if (t == "gx,gy,gtheta,d,max_range")
-      {
-        has_max_range = true;
-      }
-      else
-      {
-        throw UsageError(where + ": expected the header 'gx,gy,gtheta,d' (optionally ',max_range'), got '" + t + "'");
-      }
+      parseHeader(t, where, &has_max_range, &has_fov);
       have_header = true;
       continue;
     }
-    const std::size_t expected = has_max_range ? 5 : 4;
+    const std::size_t expected = 4 + (has_max_range ? 1 : 0) + (has_fov ? 1 : 0);
     if (fields.size() != expected)
     {
       throw UsageError(where + ": expected " + std::to_string(expected) + " fields, got " +
@@ -112,6 +137,7 @@ std::vector<core::Reading> readCsv(const std::string& path, double default_max_r
     r.offset.theta = core::parseNumber(fields[2], where + ": gtheta", true);
     r.range = core::parseNumber(fields[3], where + ": d", true);
     r.max_range = has_max_range ? core::parseNumber(fields[4], where + ": max_range", true) : default_max_range;
+    r.half_angle = has_fov ? parseFovColumn(fields.back(), where) : 0.0;
     if (!std::isfinite(r.offset.x) || !std::isfinite(r.offset.y) || !std::isfinite(r.offset.theta))
     {
       throw UsageError(where + ": gx, gy and gtheta must be finite");

@@ -209,7 +209,8 @@ TEST(BenchScoring, PaperMetricAndCriteria)
   s = core::scoreTrial(trial, result, bounds, 100, 6, 1.0);
   EXPECT_FALSE(s.has_nearest);
   EXPECT_FALSE(s.success_paper);
-  EXPECT_EQ(core::csvRow(core::BenchRow{ "a", 1, 2, "robust", 3, s }), "a,1,2,robust,3,0,0,0,0,1.000,1,,");
+  EXPECT_EQ(core::csvRow(core::BenchRow{ "a", 1, 2, "robust", 3, s }), "a,1,2,robust,3,0,0,0,0,1.000,1,,,0");
+  EXPECT_EQ(core::csvRow(core::BenchRow{ "a", 1, 2, "robust", 3, s, 27.0 }), "a,1,2,robust,3,0,0,0,0,1.000,1,,,27");
 }
 
 TEST(BenchReport, SummaryCountsAndQuantiles)
@@ -245,6 +246,73 @@ TEST(BenchReport, SummaryCountsAndQuantiles)
   EXPECT_EQ(summary[1].trials, 1);
 }
 
+using CellKey = std::tuple<std::string, int, int, std::string>;
+using CellSums = std::map<CellKey, std::vector<int>>;  // trials, paper, strict, top1
+
+/// Reads the tool's CSV (its header, then rows of 14 fields ending in fov_deg = @p fov), summing
+/// the counts per cell; returns the number of rows.
+int readCsvSums(const std::string& csv, const std::string& fov, CellSums* sums)
+{
+  std::ifstream csv_in(csv);
+  std::string line;
+  EXPECT_TRUE(std::getline(csv_in, line));
+  EXPECT_EQ(line, "scene,m,n,method,trial,success_paper,success_strict,success_top1,candidates,time_ms,"
+                  "sparsity_held,err_pos,err_theta,fov_deg");
+  int rows = 0;
+  while (std::getline(csv_in, line))
+  {
+    const std::vector<std::string> f = split(line, ',');
+    EXPECT_EQ(f.size(), 14u) << line;
+    if (f.size() != 14u)
+    {
+      return rows;
+    }
+    auto& s = (*sums)[CellKey(f[0], std::stoi(f[1]), std::stoi(f[2]), f[3])];
+    s.resize(4, 0);
+    s[0] += 1;
+    for (int c = 0; c < 3; ++c)
+    {
+      EXPECT_TRUE(f[5 + c] == "0" || f[5 + c] == "1") << line;
+      s[1 + c] += std::stoi(f[5 + c]);
+    }
+    EXPECT_EQ(f[11].empty(), f[12].empty()) << line;
+    EXPECT_EQ(f[11].empty(), f[8] == "0") << line;
+    EXPECT_EQ(f[13], fov) << line;
+    ++rows;
+  }
+  return rows;
+}
+
+/// The Markdown table: one line per cell whose trials and "paper/strict/top1" counts are the
+/// sums; returns the number of cell lines.
+int checkMarkdownAgainstSums(const std::string& md, const CellSums& sums)
+{
+  std::ifstream md_in(md);
+  std::string line;
+  int table_lines = 0;
+  while (std::getline(md_in, line))
+  {
+    const std::vector<std::string> f = split(line, '|');
+    if (f.size() != 18 || core::trim(f[1]) == "scene" || core::trim(f[1]).rfind("---", 0) == 0)
+    {
+      continue;
+    }
+    const CellKey key(core::trim(f[1]), std::stoi(core::trim(f[2])), std::stoi(core::trim(f[3])), core::trim(f[4]));
+    const auto it = sums.find(key);
+    EXPECT_NE(it, sums.end()) << line;
+    if (it == sums.end())
+    {
+      continue;
+    }
+    const std::vector<int>& s = it->second;
+    EXPECT_EQ(std::stoi(core::trim(f[5])), s[0]) << line;
+    EXPECT_EQ(core::trim(f[16]), std::to_string(s[1]) + "/" + std::to_string(s[2]) + "/" + std::to_string(s[3]))
+        << line;
+    ++table_lines;
+  }
+  return table_lines;
+}
+
 TEST(BenchTool, CsvHeaderAndTableCountsMatchRows)
 {
   const std::string dir = ::testing::TempDir();
@@ -257,55 +325,29 @@ TEST(BenchTool, CsvHeaderAndTableCountsMatchRows)
                     "--method robust,baseline --threads 2 --csv " +
                     csv + " --markdown " + md),
             0);
-
-  std::ifstream csv_in(csv);
-  std::string line;
-  ASSERT_TRUE(std::getline(csv_in, line));
-  EXPECT_EQ(line, "scene,m,n,method,trial,success_paper,success_strict,success_top1,candidates,time_ms,"
-                  "sparsity_held,err_pos,err_theta");
-  using Key = std::tuple<std::string, int, int, std::string>;
-  std::map<Key, std::vector<int>> sums;  // trials, paper, strict, top1
-  int rows = 0;
-  while (std::getline(csv_in, line))
-  {
-    const std::vector<std::string> f = split(line, ',');
-    ASSERT_EQ(f.size(), 13u) << line;
-    auto& s = sums[Key(f[0], std::stoi(f[1]), std::stoi(f[2]), f[3])];
-    s.resize(4, 0);
-    s[0] += 1;
-    for (int c = 0; c < 3; ++c)
-    {
-      ASSERT_TRUE(f[5 + c] == "0" || f[5 + c] == "1") << line;
-      s[1 + c] += std::stoi(f[5 + c]);
-    }
-    EXPECT_EQ(f[11].empty(), f[12].empty()) << line;
-    EXPECT_EQ(f[11].empty(), f[8] == "0") << line;
-    ++rows;
-  }
-  EXPECT_EQ(rows, 2 * 2 * 2 * 2);  // scenes x m x methods x trials
+  CellSums sums;
+  EXPECT_EQ(readCsvSums(csv, "0", &sums), 2 * 2 * 2 * 2);  // scenes x m x methods x trials
   ASSERT_EQ(sums.size(), 8u);
-  EXPECT_EQ(sums.count(Key("bench_l_room", 5, 32, "baseline")), 1u);
-  EXPECT_EQ(sums.count(Key("random12_x2", 0, 32, "robust")), 1u);
+  EXPECT_EQ(sums.count(CellKey("bench_l_room", 5, 32, "baseline")), 1u);
+  EXPECT_EQ(sums.count(CellKey("random12_x2", 0, 32, "robust")), 1u);
+  EXPECT_EQ(checkMarkdownAgainstSums(md, sums), 8);
+}
 
-  // The Markdown table: one line per cell whose trials and "paper/strict/top1" counts are the sums.
-  std::ifstream md_in(md);
-  int table_lines = 0;
-  while (std::getline(md_in, line))
-  {
-    const std::vector<std::string> f = split(line, '|');
-    if (f.size() != 18 || core::trim(f[1]) == "scene" || core::trim(f[1]).rfind("---", 0) == 0)
-    {
-      continue;
-    }
-    const Key key(core::trim(f[1]), std::stoi(core::trim(f[2])), std::stoi(core::trim(f[3])), core::trim(f[4]));
-    ASSERT_EQ(sums.count(key), 1u) << line;
-    const std::vector<int>& s = sums[key];
-    EXPECT_EQ(std::stoi(core::trim(f[5])), s[0]) << line;
-    EXPECT_EQ(core::trim(f[16]), std::to_string(s[1]) + "/" + std::to_string(s[2]) + "/" + std::to_string(s[3]))
-        << line;
-    ++table_lines;
-  }
-  EXPECT_EQ(table_lines, 8);
+TEST(BenchTool, FovFlagGivesEveryRowItsFieldOfView)
+{
+  const std::string dir = ::testing::TempDir();
+  const std::string poly = dir + "/bench_l_room_fov.poly";
+  core::savePolyFile(poly, lRoom()->map());
+  const std::string csv = dir + "/bench_rows_fov.csv";
+  ASSERT_EQ(runTool("--map " + poly + " --obstacles 3 --resolution 32 --trials 2 --threads 2 --fov 27 --csv " + csv),
+            0);
+  CellSums sums;
+  EXPECT_EQ(readCsvSums(csv, "27", &sums), 2);
+  EXPECT_EQ(runTool("--help"), 0);
+  EXPECT_EQ(runTool("--map " + poly + " --fov 181 --trials 1"), 2);
+  EXPECT_EQ(runTool("--map " + poly + " --fov -1 --trials 1"), 2);
+  EXPECT_EQ(runTool("--map " + poly + " --fov nan --trials 1"), 2);
+  EXPECT_EQ(runTool("--map " + poly + " --fov"), 2);
 }
 
 TEST(BenchTool, RejectsBadArguments)

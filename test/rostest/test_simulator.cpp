@@ -4,6 +4,7 @@
 #include "simulator_fixture.h"
 
 #include "fdml_localization/Kidnap.h"
+#include "fdml_localization/core/geometry/cone_cast.h"
 
 #include <std_srvs/Empty.h>
 
@@ -43,7 +44,9 @@ TEST_F(Noiseless, EveryRangeEqualsAnIndependentRayCast)
       continue;  // its ground truth has not arrived yet
     }
     const core::Pose2 sensor = core::compose(gt->second, mount(r.header.frame_id));
-    const double expected = caster_->range(sensor, r.max_range);
+    // A sensor with a field of view reads the nearest point within its cone (brute force).
+    const double expected =
+        core::coneRangeBruteForce(caster_->grid().segments(), sensor, 0.5 * r.field_of_view, r.max_range);
     expectRangeEq(r.range, expected, 1e-4, r.header.frame_id);
     per_frame[r.header.frame_id]++;
     misses += std::isinf(expected) ? 1 : 0;
@@ -239,10 +242,12 @@ struct IndependentCast
   int id = -1;
 };
 
-/// Independent cast: the static map's range @p map_range, then every obstacle as published.
-IndependentCast castWithObstacles(const core::Pose2& sensor, double max_range, double map_range,
+/// Independent cast of the cone of half-angle @p half_angle: the static map's range @p map_range,
+/// then every obstacle as published.
+IndependentCast castWithObstacles(const core::Pose2& sensor, double half_angle, double max_range, double map_range,
                                   const std::vector<visualization_msgs::Marker>& obstacles)
 {
+  const core::Sector sector = core::Sector::around(sensor, half_angle);
   IndependentCast cast;
   cast.range = map_range;
   cast.kind = std::isinf(map_range) ? fl::ReadingTruth::HIT_NONE : fl::ReadingTruth::HIT_MAP;
@@ -258,7 +263,7 @@ IndependentCast castWithObstacles(const core::Pose2& sensor, double max_range, d
     {
       const core::Segment edge{ core::Vec2(o.points[k].x, o.points[k].y),
                                 core::Vec2(o.points[k + 1].x, o.points[k + 1].y) };
-      d = std::min(d, core::raySegmentDistance(sensor.position(), sensor.heading(), edge));
+      d = std::min(d, core::sectorSegmentDistance(sector, edge));
     }
     if (d <= max_range && d < cast.range)
     {
@@ -272,10 +277,12 @@ TEST_F(Obstacles, HitLabelsMatchIndependentCasts)
 {
   ASSERT_TRUE(waitFor([this]() { return truths_.size() >= 600; })) << truths_.size() << " readings";
   std::map<std::string, double> max_range;
+  std::map<std::string, double> half_angle;
   ASSERT_TRUE(waitFor([&]() { return !ranges_.empty(); }));
   for (const auto& r : ranges_)
   {
     max_range[r.header.frame_id] = r.max_range;
+    half_angle[r.header.frame_id] = 0.5 * r.field_of_view;
   }
   std::map<int, int> kinds;
   int checked = 0;
@@ -292,8 +299,9 @@ TEST_F(Obstacles, HitLabelsMatchIndependentCasts)
     const core::Pose2 sensor = core::compose(gt->second, mount(t.header.frame_id));
     EXPECT_NEAR(t.sensor_pose.x, sensor.x, 1e-9);
     EXPECT_NEAR(t.sensor_pose.y, sensor.y, 1e-9);
-    const double map_range = caster_->range(sensor, m);
-    const IndependentCast cast = castWithObstacles(sensor, m, map_range, obstacles->second);
+    const double a = half_angle[t.header.frame_id];
+    const double map_range = core::coneRangeBruteForce(caster_->grid().segments(), sensor, a, m);
+    const IndependentCast cast = castWithObstacles(sensor, a, m, map_range, obstacles->second);
     const double best = cast.range;
     EXPECT_EQ(t.hit, cast.kind) << "reading at " << t.header.stamp << " from " << t.header.frame_id;
     EXPECT_EQ(t.obstacle_id, cast.id);

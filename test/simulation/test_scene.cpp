@@ -3,7 +3,7 @@
 #include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/simulation/scene.h"
 
-#include "test_util.h"
+#include "scene_test_util.h"
 
 #include <gtest/gtest.h>
 
@@ -16,66 +16,37 @@ namespace core
 {
 namespace
 {
-/// Independent ray/disc distance (origin outside the disc): project the centre on the ray.
-double discDistance(const Vec2& o, const Vec2& d, const Vec2& c, double r)
-{
-  const double s = (c - o).dot(d);
-  const double h2 = (c - o).squaredNorm() - s * s;
-  if (h2 > r * r)
-  {
-    return kInf;
-  }
-  const double t = s - std::sqrt(r * r - h2);
-  return t >= 0.0 ? t : kInf;
-}
+using test::insideAnyObstacle;
+using test::randomObstacles;
 
-double polygonDistance(const Vec2& o, const Vec2& d, const Ring& ring)
+/// Counts of what the casts checked.
+struct CastCounts
 {
-  double best = kInf;
-  for (std::size_t i = 0; i < ring.size(); ++i)
-  {
-    best = std::min(best, raySegmentDistance(o, d, Segment{ ring[i], ring[(i + 1) % ring.size()] }));
-  }
-  return best;
-}
+  int obstacle_hits = 0;
+  int out_of_range = 0;
+};
 
-std::vector<Obstacle> randomObstacles(const Box2& b, std::mt19937_64& rng)
+/// One scene cast against the brute-force minimum; false once a check has failed.
+bool checkCast(const Scene& scene, const std::vector<Obstacle>& obstacles, const Pose2& sensor, double max_range,
+               CastCounts* counts)
 {
-  std::uniform_real_distribution<double> ux(b.min.x(), b.max.x()), uy(b.min.y(), b.max.y());
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::vector<Obstacle> obstacles;
-  for (int i = 0; i < 20; ++i)
+  const test::BruteHit expected = test::bruteSceneRay(scene.map(), obstacles, sensor.position(), sensor.heading());
+  const SceneHit hit = scene.cast(sensor, max_range);
+  if (expected.distance > max_range)
   {
-    obstacles.push_back(Obstacle::disc(Vec2(ux(rng), uy(rng)), 0.05 + 0.5 * unit(rng)));
+    ++counts->out_of_range;
+    EXPECT_EQ(hit.kind, SceneHit::Kind::None);
+    return hit.kind == SceneHit::Kind::None;
   }
-  for (int i = 0; i < 8; ++i)
+  EXPECT_NEAR(hit.distance, expected.distance, 1e-9);
+  counts->obstacle_hits += expected.obstacle >= 0 ? 1 : 0;
+  EXPECT_EQ(hit.kind, expected.obstacle >= 0 ? SceneHit::Kind::Obstacle : SceneHit::Kind::Map);
+  EXPECT_EQ(hit.obstacle, expected.obstacle);
+  if (std::isinf(max_range))
   {
-    // Star-shaped (possibly non-convex) polygons of 3 to 7 vertices.
-    const Vec2 c(ux(rng), uy(rng));
-    const int n = 3 + i % 5;
-    Ring ring;
-    for (int k = 0; k < n; ++k)
-    {
-      const double a = kTwoPi * (k + 0.8 * unit(rng)) / n;
-      ring.push_back(c + (0.2 + 0.6 * unit(rng)) * test::unitDir(a));
-    }
-    obstacles.push_back(Obstacle::polygon(ring));
+    EXPECT_NEAR(hit.map_distance, expected.map_distance, 1e-9);
   }
-  return obstacles;
-}
-
-bool insideAnyObstacle(const Vec2& p, const std::vector<Obstacle>& obstacles)
-{
-  for (const Obstacle& o : obstacles)
-  {
-    const bool inside =
-        o.shape == Obstacle::Shape::Disc ? (p - o.centre).norm() <= o.radius : pointInRing(p, o.vertices);
-    if (inside)
-    {
-      return true;
-    }
-  }
-  return false;
+  return !::testing::Test::HasFailure();
 }
 }  // namespace
 
@@ -92,8 +63,8 @@ TEST(Scene, CastEqualsBruteForceMinimum)
     scene.setObstacles(obstacles);
     std::uniform_real_distribution<double> ux(b.min.x(), b.max.x()), uy(b.min.y(), b.max.y());
     std::uniform_real_distribution<double> angle(-kPi, kPi), unit(0.0, 1.0);
-    int casts = 0, obstacle_hits = 0, out_of_range = 0;
-    while (casts < 20000)
+    CastCounts counts;
+    for (int casts = 0; casts < 20000;)
     {
       const Vec2 p(ux(rng), uy(rng));
       if (!caster->isFree(p) || insideAnyObstacle(p, obstacles))
@@ -103,46 +74,10 @@ TEST(Scene, CastEqualsBruteForceMinimum)
       ++casts;
       const Pose2 sensor(p.x(), p.y(), angle(rng));
       const double max_range = casts % 3 == 0 ? 4.0 * unit(rng) : kInf;
-      const Vec2 d = sensor.heading();
-      const double map_distance = caster->grid().castBruteForce(p, d).distance;
-      double expected = map_distance;
-      int expected_obstacle = -1;
-      for (std::size_t i = 0; i < obstacles.size(); ++i)
-      {
-        const Obstacle& o = obstacles[i];
-        const double t = o.shape == Obstacle::Shape::Disc ? discDistance(p, d, o.centre, o.radius) :
-                                                            polygonDistance(p, d, o.vertices);
-        if (t < expected)
-        {
-          expected = t;
-          expected_obstacle = static_cast<int>(i);
-        }
-      }
-      const SceneHit hit = scene.cast(sensor, max_range);
-      if (expected > max_range)
-      {
-        ++out_of_range;
-        ASSERT_EQ(hit.kind, SceneHit::Kind::None) << "cast " << casts;
-        continue;
-      }
-      ASSERT_NEAR(hit.distance, expected, 1e-9) << "cast " << casts;
-      if (expected_obstacle >= 0)
-      {
-        ++obstacle_hits;
-        ASSERT_EQ(hit.kind, SceneHit::Kind::Obstacle) << "cast " << casts;
-        ASSERT_EQ(hit.obstacle, expected_obstacle) << "cast " << casts;
-      }
-      else
-      {
-        ASSERT_EQ(hit.kind, SceneHit::Kind::Map) << "cast " << casts;
-      }
-      if (std::isinf(max_range))
-      {
-        ASSERT_NEAR(hit.map_distance, map_distance, 1e-9) << "cast " << casts;
-      }
+      ASSERT_TRUE(checkCast(scene, obstacles, sensor, max_range, &counts)) << "cast " << casts;
     }
-    EXPECT_GT(obstacle_hits, 200);
-    EXPECT_GT(out_of_range, 100);
+    EXPECT_GT(counts.obstacle_hits, 200);
+    EXPECT_GT(counts.out_of_range, 100);
   }
 }
 

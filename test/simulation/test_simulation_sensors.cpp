@@ -1,5 +1,6 @@
 // Tests of the simulator core's sensors, odometry, robot motion, kidnapping and reset, each
 // against an independent computation (the map's own ray cast, pose algebra, statistics).
+#include "fdml_localization/core/geometry/cone_cast.h"
 #include "fdml_localization/simulation/simulation.h"
 
 #include <gtest/gtest.h>
@@ -43,6 +44,9 @@ core::ScenarioConfig loopScenario()
   c.robot.waypoints = { Vec2(0.5, 0.5), Vec2(3.5, 0.5), Vec2(3.5, 2.5), Vec2(0.5, 2.5) };
   c.sensors = { sensor("front", Pose2(0.1, 0.0, 0.0), 10.0, 5.0), sensor("left", Pose2(0.0, 0.1, 1.5708), 25.0, 1.0),
                 sensor("back", Pose2(-0.1, 0.05, 3.0), 50.0, 8.0) };
+  // A ray, the default narrow cone (0.05 rad) and a 27 deg cone.
+  c.sensors[0].fov = 0.0;
+  c.sensors[2].fov = 27.0 * core::kPi / 180.0;
   return c;
 }
 
@@ -55,7 +59,7 @@ std::unique_ptr<core::Simulation> make(const core::ScenarioConfig& c)
 }
 }  // namespace
 
-TEST(SimulationSensors, NoiseFreeReadingsEqualTheMapCastAtTheTrueSensorPose)
+TEST(SimulationSensors, NoiseFreeReadingsEqualTheMapConeCastAtTheTrueSensorPose)
 {
   const core::ScenarioConfig c = loopScenario();
   auto sim = make(c);
@@ -71,7 +75,8 @@ TEST(SimulationSensors, NoiseFreeReadingsEqualTheMapCastAtTheTrueSensorPose)
       const Pose2 pose = core::compose(sim->truePose(), c.sensors[static_cast<std::size_t>(r.sensor)].mount);
       EXPECT_NEAR(r.sensor_pose.x, pose.x, 1e-12);
       EXPECT_NEAR(r.sensor_pose.y, pose.y, 1e-12);
-      const double expected = sim->scene().map().range(pose, c.sensors[static_cast<std::size_t>(r.sensor)].max_range);
+      const core::SensorConfig& s = c.sensors[static_cast<std::size_t>(r.sensor)];
+      const double expected = core::coneRange(sim->scene().map(), pose, 0.5 * s.fov, s.max_range);
       EXPECT_EQ(r.range, expected);
       EXPECT_EQ(r.map_range, expected);
       EXPECT_EQ(r.kind, std::isinf(expected) ? core::SceneHit::Kind::None : core::SceneHit::Kind::Map);

@@ -32,6 +32,7 @@ struct ProtocolOptions
   double obstacle_step = 0.05;    ///< largest obstacle move per reading [m]
   double noise = 0.0;             ///< Gaussian range noise sigma [m] (>= 0)
   double max_range = kInf;        ///< sensor range [m]; beyond it a reading is +inf
+  double half_angle = 0.0;        ///< every reading's cone half-angle [rad] in [0, pi/2]; 0 = rays
 };
 
 /// Every problem with the options, each naming the option and its allowed range.
@@ -43,7 +44,7 @@ struct Trial
   Pose2 truth;                      ///< robot pose at the first reading (what is sought)
   std::vector<Pose2> sensor_poses;  ///< sensor pose in the map at each reading
   std::vector<Reading> readings;    ///< g_i relative to truth, and the measured range
-  std::vector<bool> hit_static;     ///< per reading: the ray hit the static map
+  std::vector<bool> hit_static;     ///< per reading: the ray (or cone) hit the static map first
   std::vector<Obstacle> obstacles;  ///< the obstacles at the first reading
   int static_hits = 0;              ///< number of readings that hit the static map
 };
@@ -57,7 +58,8 @@ std::uint64_t trialSeed(std::uint64_t seed, const std::string& scene, int m, int
  *        free, no map edge within the radius) whose centres are farther than 2 radii from every
  *        sensor position (the public prototype's rule, so a disc never covers the sensor); k readings
  *        with 2 pi / k rotation between them (plus a random collision-free step with translate;
- *        obstacles take a random step in free space between readings with moving_obstacles).
+ *        obstacles take a random step in free space between readings with moving_obstacles);
+ *        each reading the nearest point of the map or a disc within its cone (Scene::castCone).
  * @throws std::invalid_argument for invalid options, std::runtime_error when the map has no
  *         room for the robot or the obstacles after many attempts.
  */

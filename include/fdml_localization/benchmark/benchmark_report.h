@@ -24,6 +24,7 @@ struct BenchRow
   std::string method;
   int trial = 0;
   TrialScore score;
+  double fov_deg = 0.0;  ///< the readings' full field of view [deg]; 0 = rays
 };
 
 /// The table build (or load) time of one localizer, per (scene, n, method).
@@ -55,7 +56,7 @@ struct BenchSummary
   int success_not_held = 0;  ///< success_paper among the others
 };
 
-/// The CSV header: scene,m,n,method,trial,success_paper,...,err_theta (no newline).
+/// The CSV header: scene,m,n,method,trial,success_paper,...,err_theta,fov_deg (no newline).
 std::string csvHeader();
 /// One CSV row (no newline); err_* are empty when there is no candidate.
 std::string csvRow(const BenchRow& row);

@@ -84,8 +84,21 @@ boost::array<double, 36> toCovariance6(const Eigen::Matrix3d& covariance);
 /// The (x, y, theta) block of a 6x6 row-major covariance.
 Eigen::Matrix3d fromCovariance6(const boost::array<double, 36>& covariance);
 
+/**
+ * @brief The cone half-angle of a sensor's full field of view: fov / 2 [rad].
+ * @param field_of_view [rad]; valid when finite and in [0, pi] (a float32 pi, slightly above
+ *        pi, counts as pi)
+ * @param[out] half_angle in [0, pi/2] when valid
+ * @return false when @p field_of_view is invalid (@p half_angle untouched)
+ */
+bool fieldOfViewToHalfAngle(double field_of_view, double* half_angle);
+
+/// The message of a reading; field_of_view = 2 half_angle.
 fdml_localization::Reading toReadingMsg(const core::Reading& reading);
+/// The reading of a message; half_angle = field_of_view / 2.
+/// @throws std::invalid_argument "field_of_view: ..." when field_of_view is invalid
 core::Reading fromReadingMsg(const fdml_localization::Reading& reading);
+/// @throws std::invalid_argument "readings[i].field_of_view: ..." naming the first invalid one
 std::vector<core::Reading> fromReadingMsgs(const std::vector<fdml_localization::Reading>& readings);
 
 fdml_localization::Candidate toCandidateMsg(const core::Candidate& candidate);

@@ -31,6 +31,7 @@ constexpr const char* kNegativeRange = "negative_range";                ///< fin
 constexpr const char* kBelowMinRange = "below_min_range";               ///< range < min_range
 constexpr const char* kAboveMaxRange = "above_max_range";               ///< finite range > max_range
 constexpr const char* kInvalidLimits = "invalid_limits";                ///< min/max_range NaN, max <= 0 or max < min
+constexpr const char* kInvalidFieldOfView = "invalid_field_of_view";    ///< Range.field_of_view NaN or outside [0, pi]
 constexpr const char* kEmptyFrameId = "empty_frame_id";                 ///< header.frame_id is empty
 constexpr const char* kZeroStamp = "zero_stamp";                        ///< header.stamp is 0 (unusable with odometry)
 constexpr const char* kStampBackwards = "stamp_backwards";              ///< older than the last reading of its frame
@@ -55,6 +56,7 @@ struct TimedReading
   core::Pose2 beam;               ///< the beam's pose in the sensor frame (a LaserScan beam: (0, 0, angle))
   double range = core::kInf;      ///< [m]; +inf = no return
   double max_range = core::kInf;  ///< [m]
+  double half_angle = 0.0;        ///< cone half-angle [rad]: Range.field_of_view / 2 (0 = a ray)
   double received = 0.0;          ///< arrival time on the node's clock [s] (starts the transform wait)
 };
 

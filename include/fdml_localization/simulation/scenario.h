@@ -65,7 +65,7 @@ struct SensorConfig
   double rate = 10.0;        ///< readings per second [Hz]
   double min_range = 0.02;   ///< [m]
   double max_range = 4.0;    ///< [m]
-  double fov = 0.05;         ///< field of view for sensor_msgs/Range [rad] (the ray is the axis)
+  double fov = 0.05;         ///< field of view [rad] in [0, pi]: reads the nearest point in the cone; 0 = a ray
   double noise_sigma = 0.0;  ///< Gaussian range noise standard deviation [m]
   double dropout = 0.0;      ///< probability that a reading is lost, in [0, 1]
 };

@@ -5,7 +5,7 @@
  */
 #pragma once
 
-#include "fdml_localization/core/geometry/ray_caster.h"
+#include "fdml_localization/core/geometry/cone_cast.h"
 
 #include <memory>
 #include <vector>
@@ -36,6 +36,9 @@ struct Obstacle
   Box2 bounds() const;
   /// Nearest hit of a ray on the obstacle's boundary [m] (+inf on a miss; 0 when the origin is inside).
   double castDistance(const Vec2& origin, const Vec2& dir) const;
+  /// Distance from the sector's apex to the obstacle's nearest point inside the sector [m]
+  /// (+inf when it does not meet the sector; 0 when the apex is inside).
+  double sectorDistance(const Sector& sector) const;
 };
 
 /// What a scene ray cast hit first.
@@ -74,6 +77,13 @@ public:
 
   /// Nearest hit from @p sensor along its +x axis within @p max_range.
   SceneHit cast(const Pose2& sensor, double max_range = kInf) const;
+
+  /**
+   * @brief Nearest point of the map or an obstacle inside the sector of half-angle
+   *        @p half_angle [rad] in [0, pi/2] around the sensor's +x axis, within @p max_range
+   *        (the cone sensor's reading, cone_cast.h). half_angle = 0 is cast().
+   */
+  SceneHit castCone(const Pose2& sensor, double half_angle, double max_range = kInf) const;
 
   /// True when p is free in the map and outside every obstacle.
   bool isFree(const Vec2& p) const;

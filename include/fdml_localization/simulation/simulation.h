@@ -145,6 +145,8 @@ private:
 
   bool placeRobot(std::vector<std::string>* errors);
   bool placeObstacles(std::vector<std::string>* errors);
+  bool placeObstacle(std::size_t group, int k, ObstacleState* state, std::string* error);
+  bool obstacleApart(std::size_t index, const Vec2& p) const;
   bool checkWaypoints(std::vector<std::string>* errors) const;
   bool discClearOfWalls(const Vec2& centre, double radius) const;
   bool pathClearOfWalls(const Vec2& a, const Vec2& b, double radius) const;
@@ -153,6 +155,8 @@ private:
   void moveRobot();
   void moveObstacles();
   void moveObstacle(std::size_t index);
+  void moveAlongWaypoints(std::size_t index);
+  void moveOrReflect(std::size_t index);
   void updateOdometry(const Pose2& before);
   void syncScene();
   void takeReadings(StepOutput* out);

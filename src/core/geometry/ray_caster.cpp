@@ -38,32 +38,40 @@ SegmentGrid::SegmentGrid(std::vector<Segment> segments, double cell_size) : segm
   nx_ = std::max(1, static_cast<int>(std::ceil(size.x() / cell_)));
   ny_ = std::max(1, static_cast<int>(std::ceil(size.y() / cell_)));
 
-  // Two passes (count, then fill) into compressed rows. A cell takes a segment that touches
-  // the cell inflated by a small margin, so that hits on cell borders are found from both sides.
+  buildCells();
+}
+
+template <typename Fn>
+void SegmentGrid::forEachCellTouching(const Segment& s, Fn&& fn) const
+{
   const double margin = 1e-9 * std::max(1.0, cell_);
-  std::vector<std::uint32_t> counts(static_cast<std::size_t>(nx_) * ny_ + 1, 0);
-  auto visit = [&](const Segment& s, auto&& fn) {
-    const int x0 = cellX(std::min(s.a.x(), s.b.x()) - margin);
-    const int x1 = cellX(std::max(s.a.x(), s.b.x()) + margin);
-    const int y0 = cellY(std::min(s.a.y(), s.b.y()) - margin);
-    const int y1 = cellY(std::max(s.a.y(), s.b.y()) + margin);
-    for (int cy = y0; cy <= y1; ++cy)
+  const int x0 = cellX(std::min(s.a.x(), s.b.x()) - margin);
+  const int x1 = cellX(std::max(s.a.x(), s.b.x()) + margin);
+  const int y0 = cellY(std::min(s.a.y(), s.b.y()) - margin);
+  const int y1 = cellY(std::max(s.a.y(), s.b.y()) + margin);
+  for (int cy = y0; cy <= y1; ++cy)
+  {
+    for (int cx = x0; cx <= x1; ++cx)
     {
-      for (int cx = x0; cx <= x1; ++cx)
+      Box2 cell;
+      cell.min = bounds_.min + Vec2(cx * cell_ - margin, cy * cell_ - margin);
+      cell.max = bounds_.min + Vec2((cx + 1) * cell_ + margin, (cy + 1) * cell_ + margin);
+      if (segmentIntersectsBox(s, cell))
       {
-        Box2 cell;
-        cell.min = bounds_.min + Vec2(cx * cell_ - margin, cy * cell_ - margin);
-        cell.max = bounds_.min + Vec2((cx + 1) * cell_ + margin, (cy + 1) * cell_ + margin);
-        if (segmentIntersectsBox(s, cell))
-        {
-          fn(static_cast<std::size_t>(cy) * nx_ + cx);
-        }
+        fn(static_cast<std::size_t>(cy) * nx_ + cx);
       }
     }
-  };
+  }
+}
+
+void SegmentGrid::buildCells()
+{
+  // Two passes (count, then fill) into compressed rows. A cell takes a segment that touches
+  // the cell inflated by a small margin, so that hits on cell borders are found from both sides.
+  std::vector<std::uint32_t> counts(static_cast<std::size_t>(nx_) * ny_ + 1, 0);
   for (const Segment& s : segments_)
   {
-    visit(s, [&](std::size_t cell) { ++counts[cell + 1]; });
+    forEachCellTouching(s, [&](std::size_t cell) { ++counts[cell + 1]; });
   }
   cell_start_.assign(counts.size(), 0);
   for (std::size_t i = 1; i < counts.size(); ++i)
@@ -74,7 +82,7 @@ SegmentGrid::SegmentGrid(std::vector<Segment> segments, double cell_size) : segm
   std::vector<std::uint32_t> fill(cell_start_.begin(), cell_start_.end() - 1);
   for (std::size_t i = 0; i < segments_.size(); ++i)
   {
-    visit(segments_[i], [&](std::size_t cell) { cell_items_[fill[cell]++] = static_cast<int>(i); });
+    forEachCellTouching(segments_[i], [&](std::size_t cell) { cell_items_[fill[cell]++] = static_cast<int>(i); });
   }
 }
 
@@ -107,23 +115,16 @@ RayHit SegmentGrid::castBruteForce(const Vec2& origin, const Vec2& dir, double m
   return best;
 }
 
-RayHit SegmentGrid::cast(const Vec2& origin, const Vec2& dir, double max_range) const
+bool SegmentGrid::clipToBounds(const Vec2& origin, const Vec2& dir, double* t_enter, double* t_exit) const
 {
-  RayHit best;
-  if (segments_.empty())
-  {
-    return best;
-  }
-  // Clip the ray to the grid's box (slab test).
-  double t_enter = 0.0;
-  double t_exit = max_range;
+  // Slab test against the grid's box.
   for (int axis = 0; axis < 2; ++axis)
   {
     if (dir[axis] == 0.0)
     {
       if (origin[axis] < bounds_.min[axis] || origin[axis] > bounds_.max[axis])
       {
-        return best;
+        return false;
       }
       continue;
     }
@@ -133,10 +134,46 @@ RayHit SegmentGrid::cast(const Vec2& origin, const Vec2& dir, double max_range) 
     {
       std::swap(ta, tb);
     }
-    t_enter = std::max(t_enter, ta);
-    t_exit = std::min(t_exit, tb);
+    *t_enter = std::max(*t_enter, ta);
+    *t_exit = std::min(*t_exit, tb);
   }
-  if (t_enter > t_exit)
+  return *t_enter <= *t_exit;
+}
+
+void SegmentGrid::castInCell(std::size_t cell, const Vec2& origin, const Vec2& dir, RayHit* best) const
+{
+  for (std::uint32_t k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k)
+  {
+    const int i = cell_items_[k];
+    const double t = raySegmentDistance(origin, dir, segments_[i]);
+    if (t < best->distance || (t == best->distance && i < best->segment))
+    {
+      best->distance = t;
+      best->segment = i;
+    }
+  }
+}
+
+double SegmentGrid::nextBorder(const Vec2& origin, const Vec2& dir, int axis, int c, int step) const
+{
+  if (dir[axis] == 0.0)
+  {
+    return kInf;
+  }
+  const double border = bounds_.min[axis] + (step > 0 ? c + 1 : c) * cell_;
+  return (border - origin[axis]) / dir[axis];
+}
+
+RayHit SegmentGrid::cast(const Vec2& origin, const Vec2& dir, double max_range) const
+{
+  RayHit best;
+  if (segments_.empty())
+  {
+    return best;
+  }
+  double t_enter = 0.0;
+  double t_exit = max_range;
+  if (!clipToBounds(origin, dir, &t_enter, &t_exit))
   {
     return best;
   }
@@ -145,33 +182,14 @@ RayHit SegmentGrid::cast(const Vec2& origin, const Vec2& dir, double max_range) 
   int cy = cellY(start.y());
   const int step_x = dir.x() > 0.0 ? 1 : -1;
   const int step_y = dir.y() > 0.0 ? 1 : -1;
-  // Ray parameter at which the ray leaves the current cell through an x (or y) border.
-  auto next_border = [&](int axis, int c, int step) {
-    if (dir[axis] == 0.0)
-    {
-      return kInf;
-    }
-    const double border = bounds_.min[axis] + (step > 0 ? c + 1 : c) * cell_;
-    return (border - origin[axis]) / dir[axis];
-  };
-  double t_max_x = next_border(0, cx, step_x);
-  double t_max_y = next_border(1, cy, step_y);
+  double t_max_x = nextBorder(origin, dir, 0, cx, step_x);
+  double t_max_y = nextBorder(origin, dir, 1, cy, step_y);
   const double dt_x = dir.x() == 0.0 ? kInf : cell_ / std::abs(dir.x());
   const double dt_y = dir.y() == 0.0 ? kInf : cell_ / std::abs(dir.y());
 
   while (true)
   {
-    const std::size_t cell = static_cast<std::size_t>(cy) * nx_ + cx;
-    for (std::uint32_t k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k)
-    {
-      const int i = cell_items_[k];
-      const double t = raySegmentDistance(origin, dir, segments_[i]);
-      if (t < best.distance || (t == best.distance && i < best.segment))
-      {
-        best.distance = t;
-        best.segment = i;
-      }
-    }
+    castInCell(static_cast<std::size_t>(cy) * nx_ + cx, origin, dir, &best);
     const double t_cell_exit = std::min(t_max_x, t_max_y);
     // Any hit in a later cell lies beyond this cell's exit. The tiny slack keeps ties (a hit
     // exactly on the border) resolved the same way as the brute-force loop.

@@ -116,20 +116,39 @@ private:
   std::string report_;
 };
 
-/// Casts >= 100,000 rays of several kinds on @p map.
-void checkMapRays(const NamedMap& named, const SegmentGrid& grid, std::uint64_t seed)
+/// Random draws for the ray kinds: points around the map, angles, edges.
+struct RayDraw
 {
-  std::mt19937_64 rng(seed);
-  const Box2& b = named.map.bounds();
-  const Vec2 pad = 0.1 * b.size();
-  std::uniform_real_distribution<double> ux(b.min.x() - pad.x(), b.max.x() + pad.x());
-  std::uniform_real_distribution<double> uy(b.min.y() - pad.y(), b.max.y() + pad.y());
-  std::uniform_real_distribution<double> angle(-kPi, kPi);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  const std::vector<Segment>& edges = named.map.edges();
-  CastChecker checker(grid);
-  auto random_point = [&] { return Vec2(ux(rng), uy(rng)); };
+  RayDraw(const PolygonMap& map, std::uint64_t seed)
+    : rng(seed)
+    , ux(map.bounds().min.x() - 0.1 * map.bounds().size().x(), map.bounds().max.x() + 0.1 * map.bounds().size().x())
+    , uy(map.bounds().min.y() - 0.1 * map.bounds().size().y(), map.bounds().max.y() + 0.1 * map.bounds().size().y())
+    , edges(map.edges())
+  {}
+  Vec2 point()
+  {
+    return Vec2(ux(rng), uy(rng));
+  }
+  const Segment& edge()
+  {
+    return edges[rng() % edges.size()];
+  }
 
+  std::mt19937_64 rng;
+  std::uniform_real_distribution<double> ux;
+  std::uniform_real_distribution<double> uy;
+  std::uniform_real_distribution<double> angle{ -kPi, kPi };
+  std::uniform_real_distribution<double> unit{ 0.0, 1.0 };
+  const std::vector<Segment>& edges;
+};
+
+/// Random rays from inside and outside the map, with and without a range, and axis-aligned ones.
+void checkRandomRays(RayDraw& draw, const Box2& b, CastChecker& checker)
+{
+  std::mt19937_64& rng = draw.rng;
+  auto random_point = [&] { return draw.point(); };
+  auto& angle = draw.angle;
+  auto& unit = draw.unit;
   // 1. Random rays from inside and outside the map.
   for (int i = 0; i < 50000; ++i)
   {
@@ -145,7 +164,7 @@ void checkMapRays(const NamedMap& named, const SegmentGrid& grid, std::uint64_t 
   for (int i = 0; i < 10000; ++i)
   {
     Vec2 o = random_point();
-    const Segment& e = edges[rng() % edges.size()];
+    const Segment& e = draw.edge();
     if (i % 2 == 0)
     {
       o.y() = e.a.y();
@@ -156,10 +175,19 @@ void checkMapRays(const NamedMap& named, const SegmentGrid& grid, std::uint64_t 
     }
     checker.check(o, axes[i % 4]);
   }
+}
+
+/// Rays through and from vertices, and rays parallel to edges.
+void checkVertexAndParallelRays(RayDraw& draw, CastChecker& checker)
+{
+  std::mt19937_64& rng = draw.rng;
+  auto random_point = [&] { return draw.point(); };
+  auto& angle = draw.angle;
+  auto& unit = draw.unit;
   // 4. Rays through vertices from random origins, and rays leaving a vertex.
   for (int i = 0; i < 15000; ++i)
   {
-    const Segment& e = edges[rng() % edges.size()];
+    const Segment& e = draw.edge();
     const Vec2 o = random_point();
     if ((e.a - o).norm() > 1e-9)
     {
@@ -172,7 +200,7 @@ void checkMapRays(const NamedMap& named, const SegmentGrid& grid, std::uint64_t 
   const double offsets[] = { 0.0, 1e-12, -1e-12, 1e-9, -1e-9, 1e-3, -1e-3, 0.25, -0.25 };
   for (int i = 0; i < 15000; ++i)
   {
-    const Segment& e = edges[rng() % edges.size()];
+    const Segment& e = draw.edge();
     const Vec2 along = (e.b - e.a).normalized();
     const Vec2 normal(-along.y(), along.x());
     const double s = -1.0 + 3.0 * unit(rng);
@@ -180,6 +208,15 @@ void checkMapRays(const NamedMap& named, const SegmentGrid& grid, std::uint64_t 
     const Vec2 o = base + offsets[i % 9] * normal;
     checker.check(o, (i % 2 == 0) ? along : Vec2(-along));
   }
+}
+
+/// Casts >= 100,000 rays of several kinds on @p map.
+void checkMapRays(const NamedMap& named, const SegmentGrid& grid, std::uint64_t seed)
+{
+  RayDraw draw(named.map, seed);
+  CastChecker checker(grid);
+  checkRandomRays(draw, named.map.bounds(), checker);
+  checkVertexAndParallelRays(draw, checker);
   EXPECT_GE(checker.rays(), 100000) << named.name;
   EXPECT_GT(checker.hits(), checker.rays() / 4) << named.name;
   EXPECT_EQ(checker.failures(), 0) << named.name << " (" << grid.segments().size() << " edges, cell " << grid.cellSize()

@@ -1,9 +1,9 @@
 /**
  * @file cone_cast.h
- * @brief The reading model of a wide-cone range sensor: the nearest map point within a sector.
+ * @brief The reading model of a wide-cone range sensor: the nearest point within a sector.
  *
  * A sensor at pose p with half-angle a reports the distance to the nearest point of any map
- * edge inside the sector {p.position + r (cos phi, sin phi) : r >= 0, phi in
+ * edge inside the closed sector {p.position + r (cos phi, sin phi) : r >= 0, phi in
  * [p.theta - a, p.theta + a]}, or nothing when no edge point of the sector lies within its
  * maximum range. With a = 0 this is the ray cast of MapRayCaster::range().
  */
@@ -20,12 +20,38 @@ namespace core
 /// Largest half-angle a cone reading may have [rad]: a half-plane.
 constexpr double kMaxConeHalfAngle = 1.5707963267948966;
 
+/// A sector of directions: the apex and the unit directions of its two bounding rays.
+struct Sector
+{
+  Vec2 origin = Vec2::Zero();  ///< apex [m]
+  Vec2 right = Vec2::UnitX();  ///< unit direction at heading - a
+  Vec2 left = Vec2::UnitX();   ///< unit direction at heading + a
+
+  /// The sector of half-angle @p half_angle [rad] in [0, pi/2] around the pose's +x axis.
+  static Sector around(const Pose2& sensor, double half_angle);
+  /// True when @p p lies in the closed sector.
+  bool contains(const Vec2& p) const;
+};
+
 /**
- * @brief Distance from @p origin to the nearest point of @p seg inside the sector of unit
- *        directions @p right (heading - a) and @p left (heading + a), a in [0, pi/2].
+ * @brief Distance from the sector's apex to the nearest point of @p seg inside the sector
+ *        (opening at most pi).
  * @return the distance [m], +inf when the segment does not meet the sector
  */
+double sectorSegmentDistance(const Sector& sector, const Segment& seg);
+
+/// The same, the sector given by its apex and bounding directions (see Sector).
 double sectorSegmentDistance(const Vec2& origin, const Vec2& right, const Vec2& left, const Segment& seg);
+
+/**
+ * @brief Distance from the sector's apex to the nearest point of the solid disc (centre,
+ *        radius) inside the sector: 0 when the apex is in the disc, +inf when the disc does
+ *        not meet the sector. The nearest point of the disc when it lies in the sector, else
+ *        the nearer entry point of the two bounding rays.
+ * @param centre [m]
+ * @param radius [m], >= 0
+ */
+double sectorCircleDistance(const Sector& sector, const Vec2& centre, double radius);
 
 /**
  * @brief The exact cone cast: distance from @p sensor to the nearest map edge point inside the
@@ -33,6 +59,7 @@ double sectorSegmentDistance(const Vec2& origin, const Vec2& right, const Vec2& 
  * @param half_angle [rad] in [0, pi/2]; 0 casts the central ray
  * @param max_range [m]; points farther away are ignored
  * @return the distance [m], +inf when nothing lies in the sector within @p max_range
+ * @throws std::invalid_argument when @p half_angle is NaN or outside [0, pi/2]
  */
 double coneRange(const MapRayCaster& map, const Pose2& sensor, double half_angle, double max_range = kInf);
 

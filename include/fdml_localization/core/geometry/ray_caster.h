@@ -52,6 +52,36 @@ public:
   /// Calls @p fn(index) once for every segment touching the box; stops early when fn returns false.
   void forEachSegmentInBox(const Box2& box, const std::function<bool(int)>& fn) const;
 
+  /**
+   * @brief Calls @p fn(cell, first, last) for every grid cell overlapping @p box: the cell's
+   *        box [m] and the indices [first, last) of the segments touching it (a segment spans
+   *        several cells, so it may be reported several times); stops when fn returns false.
+   */
+  template <typename Fn>
+  void forEachCellInBox(const Box2& box, Fn&& fn) const
+  {
+    if (segments_.empty() || !box.intersects(bounds_))
+    {
+      return;
+    }
+    const int x1 = cellX(box.max.x());
+    const int y1 = cellY(box.max.y());
+    for (int cy = cellY(box.min.y()); cy <= y1; ++cy)
+    {
+      for (int cx = cellX(box.min.x()); cx <= x1; ++cx)
+      {
+        Box2 cell;
+        cell.min = bounds_.min + Vec2(cx * cell_, cy * cell_);
+        cell.max = cell.min + Vec2(cell_, cell_);
+        const std::size_t c = static_cast<std::size_t>(cy) * nx_ + cx;
+        if (!fn(cell, cell_items_.data() + cell_start_[c], cell_items_.data() + cell_start_[c + 1]))
+        {
+          return;
+        }
+      }
+    }
+  }
+
   /// Number of segments crossed by the horizontal half-line from p towards +x.
   int crossingsToRight(const Vec2& p) const;
 
@@ -69,9 +99,20 @@ public:
   }
 
 private:
+  /// Fills the cells' compressed rows of segment indices.
+  void buildCells();
+  /// Calls fn(cell index) for every cell the segment touches (cells inflated by a margin).
+  template <typename Fn>
+  void forEachCellTouching(const Segment& s, Fn&& fn) const;
+  /// Clips origin + t dir to the grid's box: [t_enter, t_exit] narrowed; false when it misses.
+  bool clipToBounds(const Vec2& origin, const Vec2& dir, double* t_enter, double* t_exit) const;
+  /// Makes @p best the nearest of itself and the cell's segments hit (ties: the lower index).
+  void castInCell(std::size_t cell, const Vec2& origin, const Vec2& dir, RayHit* best) const;
+  /// Ray parameter at which origin + t dir leaves cell column/row @p c through its border on
+  /// the @p step side along @p axis (+inf when dir is parallel to that border).
+  double nextBorder(const Vec2& origin, const Vec2& dir, int axis, int c, int step) const;
   int cellX(double x) const;
   int cellY(double y) const;
-  const std::vector<int>& cellList(int cx, int cy) const;
 
   std::vector<Segment> segments_;
   Box2 bounds_;
@@ -80,7 +121,6 @@ private:
   int ny_ = 0;
   std::vector<std::uint32_t> cell_start_;  ///< CSR offsets, size nx*ny+1
   std::vector<int> cell_items_;            ///< segment indices per cell
-  std::vector<int> empty_;
 };
 
 /**

@@ -44,6 +44,7 @@
 #include <fdml_localization/Relocalize.h>
 
 #include <diagnostic_updater/diagnostic_updater.h>
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
@@ -84,7 +85,10 @@ private:
   /// The message of a service refused before the worker can answer; empty when it can.
   std::string refusalLocked() const;
   void mapCallback(const nav_msgs::OccupancyGrid::ConstPtr& msg);
+  /// Stores a user's pose hint for the worker (ignores this node's own hand-over).
+  void initialPoseCallback(const ros::MessageEvent<const geometry_msgs::PoseWithCovarianceStamped>& event);
   void processTimer(const ros::WallTimerEvent& event);
+  void statusTimer(const ros::WallTimerEvent& event);
   void tfTimer(const ros::WallTimerEvent& event);
 
   Params params_;
@@ -102,11 +106,13 @@ private:
   ResultPublisher publisher_;
   SensorInput input_;
   ros::Subscriber map_sub_;  ///< with ~use_map_topic only
+  ros::Subscriber initialpose_sub_;
   std::unique_ptr<SolverWorker> worker_;
   ros::ServiceServer relocalize_srv_;
   ros::ServiceServer localize_srv_;
   ros::ServiceServer global_localization_srv_;
   ros::WallTimer process_timer_;
+  ros::WallTimer status_timer_;
   ros::WallTimer tf_timer_;
 };
 

@@ -140,6 +140,10 @@ void HypothesisTracker::seed(const std::vector<Candidate>& candidates, const Pos
     h.last_fix = c;
     hypotheses_.push_back(std::move(h));
   }
+  if (!candidates.empty())
+  {
+    failed_updates_ = 0;
+  }
   prune();
 }
 
@@ -250,6 +254,15 @@ void HypothesisTracker::clear()
 {
   hypotheses_.clear();
   failed_updates_ = 0;
+}
+
+void HypothesisTracker::restore(std::vector<Hypothesis> hypotheses)
+{
+  hypotheses_ = std::move(hypotheses);
+  for (const Hypothesis& h : hypotheses_)
+  {
+    next_id_ = std::max(next_id_, h.id + 1);
+  }
 }
 
 const Hypothesis* HypothesisTracker::clearlySupported() const

@@ -142,6 +142,8 @@ public:
 
   /// Drops every hypothesis (a relocalization).
   void clear();
+  /// Replaces the hypotheses (carried over to a tracker of a new map of the same frame).
+  void restore(std::vector<Hypothesis> hypotheses);
 
   /// The hypotheses, best (most supported) first.
   const std::vector<Hypothesis>& hypotheses() const

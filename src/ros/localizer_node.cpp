@@ -184,6 +184,7 @@ void LocalizerNode::startRelocalizationLocked(const OutcomePromise& waiter)
   state_.relocalizing = true;
   ++state_.generation;
   state_.activity = "relocalizing: waiting for " + std::to_string(params_.measurements_per_batch) + " fresh readings";
+  state_.tracking.message = state_.activity;
 }
 
 bool LocalizerNode::relocalizeService(fdml_localization::Relocalize::Request& req,
@@ -220,7 +221,8 @@ bool LocalizerNode::relocalizeService(fdml_localization::Relocalize::Request& re
     res.message = "timed out after " + std::to_string(timeout) + " s: " + state_.tracking.message + "; " +
                   std::to_string(state_.buffer.resolvedCount()) + " readings ready, " +
                   std::to_string(state_.buffer.pendingCount()) +
-                  " waiting for tf (the relocalization goes on: ~pose and map -> odom follow once one hypothesis is "
+                  " waiting for tf (publish range/scan readings and tf while the robot drives or rotates in place or "
+                  "the sensors sweep; the relocalization goes on: ~pose and map -> odom follow once one hypothesis is "
                   "clearly supported)";
     return true;
   }

@@ -99,6 +99,11 @@ private:
     const bool ok =
         present && error <= 0.1 && std::abs(std::remainder(pose.yaw - truth.yaw, 2.0 * M_PI)) <= 5.0 * M_PI / 180.0;
     (!present ? absent : ok ? right : wrong) += 1;
+    if (present != was_present_)
+    {
+      ROS_INFO("pose %s at %.1f s", present ? "published again" : "absent", t);
+      was_present_ = present;
+    }
     if (ok && first_fix < 0.0)
     {
       first_fix = t;
@@ -114,6 +119,11 @@ private:
       recovered = t - kidnap_time;
     }
     worst_error = present && !ok ? std::max(worst_error, error) : worst_error;
+    if (present && !ok)
+    {
+      ROS_INFO("wrong at %.1f s: %.3f m, %.1f deg off", t, error,
+               std::abs(std::remainder(pose.yaw - truth.yaw, 2.0 * M_PI)) * 180.0 / M_PI);
+    }
   }
 
 private:
@@ -123,6 +133,7 @@ private:
   ros::Time valid_until_;
   Pose odom_, map_to_odom_;
   double next_sample_ = 0.0;
+  bool was_present_ = false;
 };
 }  // namespace
 

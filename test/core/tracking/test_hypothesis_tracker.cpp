@@ -138,7 +138,7 @@ TEST(HypothesisTracker, LoneWeakHypothesisIsNotClearlySupported)
     tracker.update(batch.readings, batch.reference);
     ++updates;
   }
-  // Support 1 per perfect update, decayed by 0.9: min_support 3 needs at least 4 updates.
+  // Support 1 per perfect update, decayed by 0.95: min_support 3 needs at least 4 updates.
   EXPECT_GE(updates, 4);
   EXPECT_LE(updates, 8);
   EXPECT_EQ(tracker.state(), core::TrackState::Tracking);

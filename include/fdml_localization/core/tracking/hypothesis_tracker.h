@@ -53,12 +53,12 @@ struct TrackerOptions
   double cell_theta = 0.025;    ///< ... in theta [rad], (0, box_min_theta]
   /// support <- decay support + net consensus / k per update; a miss adds the best consensus
   /// (below k') refined in its box, 0 for an empty box. In (0, 1).
-  double support_decay = 0.9;
+  double support_decay = 0.95;
   double min_support = 3.0;           ///< a clearly supported hypothesis has at least this support, > 0
   double support_margin = 1.5;        ///< ... and this much more than any other, >= 0
   int tolerated_misses = 1;           ///< ... and missed at most this many updates in a row, >= 0
   int max_misses = 10;                ///< a hypothesis missing this many updates in a row is dropped, >= 1
-  int lost_updates = 3;               ///< every hypothesis missed this many updates in a row: lost, >= 1
+  int lost_updates = 6;               ///< every hypothesis missed this many updates in a row: lost, >= 1
   int max_hypotheses = 10;            ///< the least supported beyond this are dropped, >= 1
   double merge_distance = 0.1;        ///< hypotheses closer than this [m] ...
   double merge_angle = 0.1;           ///< ... and this [rad] are merged (the better kept)

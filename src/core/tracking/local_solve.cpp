@@ -102,6 +102,12 @@ LocalSolveOutcome localSolve(const MapRayCaster& map, const BoxOccupancy& occupa
     if (netConsensus(c) >= settings.min_consensus && insideBox(c.pose, box, settings.cell_xy, settings.cell_theta))
     {
       fixes.push_back(std::move(c));
+      // The box's centre (the prediction) reached the most any leaf may explain: no start can
+      // do better.
+      if (fixes.size() == 1 && fixes[0].inliers >= outcome.best_possible && fixes[0].contradicted == 0)
+      {
+        break;
+      }
     }
   }
   outcome.fixes =

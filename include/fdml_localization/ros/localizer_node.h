@@ -20,16 +20,12 @@
  * solve. A grid that cannot be converted is logged and counted and the previous map stays in
  * use. Until there is a map, ~relocalize and ~localize fail with "no map yet".
  *
- * Relocalization (~relocalize, global_localization) clears the buffer and waits for k fresh
- * readings, each taken at its own stamp: the readings must differ, so the robot must rotate
- * in place (or drive) or the sensors must sweep while it waits. The readings' relative poses
- * come from odometry and the sensors' mounting on tf. map -> odom is not published from the
- * request until the next unambiguous answer.
- *
- * ~pose and map -> odom are published only when the best candidate is unambiguous: there is
- * exactly one candidate, or the best's net consensus is strictly larger than the second's
- * (core::isUnambiguous(), the one rule in the core). Candidates tied on net consensus are
- * different places that explain the readings equally well (a symmetric room): no pose is claimed.
+ * Tracking (docs/localizer_node.md#tracking): the worker updates a core::HypothesisTracker with
+ * every batch; global searches seed it at start (continuous mode), on ~relocalize,
+ * global_localization and initialpose hints, on a detected kidnap (continuous mode) and after
+ * ~global_interval updates without a clearly supported hypothesis. ~relocalize answers once one
+ * hypothesis is clearly supported. ~pose and map -> odom follow every update while one is, and
+ * are withdrawn otherwise; ~status reports the state.
  */
 #pragma once
 

@@ -116,7 +116,6 @@ std::string SolverWorker::applyHint(const PoseHint& hint, const Job& job)
                   "initialpose refused: no pose within its 3-sigma box (+-%.2f m, +-%.2f rad) explains %d of the %zu "
                   "readings; the best found explains %d",
                   xy, theta, outcome.min_consensus, job.readings.size(), std::max(0, outcome.best_consensus));
-    ROS_WARN("fdml_localizer: %s", text);
     return text;
   }
   updates_since_global_ = 0;
@@ -223,7 +222,9 @@ Outcome SolverWorker::trackBatch(const Job& job)
   }
   if (!event.empty() && !kidnap)
   {
-    ROS_INFO("fdml_localizer: %s", event.c_str());
+    const bool refused = event.rfind("initialpose refused", 0) == 0;
+    ROS_LOG(refused ? ros::console::levels::Warn : ros::console::levels::Info, ROSCONSOLE_DEFAULT_NAME,
+            "fdml_localizer: %s", event.c_str());
   }
   return outcome;
 }

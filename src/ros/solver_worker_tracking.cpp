@@ -145,10 +145,68 @@ core::Result SolverWorker::trackedResult(const Job& job) const
   return result;
 }
 
+std::string SolverWorker::stepTracker(const Directive& directive, const Job& job)
+{
+  try
+  {
+    if (directive.hint)
+    {
+      return applyHint(*directive.hint, job);
+    }
+    if (needsGlobalSearch(directive.relocalizing))
+    {
+      return globalSearch(job);
+    }
+    if (!tracker_->hypotheses().empty())
+    {
+      tracker_->update(job.readings, job.batch.base_first);
+      ++updates_since_global_;
+    }
+    return std::string();
+  }
+  catch (const std::exception& error)
+  {
+    return std::string("tracking failed: ") + error.what();
+  }
+}
+
+std::string SolverWorker::lostTrackEvent(core::TrackState track, bool* kidnap)
+{
+  *kidnap = was_tracking_ && track == core::TrackState::Lost;
+  was_tracking_ = tracker_->clearlySupported() != nullptr || (was_tracking_ && track != core::TrackState::Lost);
+  if (!*kidnap)
+  {
+    return std::string();
+  }
+  const std::string missed =
+      "every hypothesis missed " + std::to_string(params_.tracker.lost_updates) + " updates in a row";
+  return solveMode(params_) == SolveMode::Continuous ? "kidnap detected: " + missed + "; relocalizing" :
+                                                       "track lost: " + missed + "; call ~relocalize";
+}
+
+void SolverWorker::publishTracking(const Job& job, const core::Result& result, const Outcome& outcome)
+{
+  publisher_.publishBatch(job, result, outcome, outcome.success, *map_);
+  const core::Hypothesis* supported = tracker_->clearlySupported();
+  if (!supported)
+  {
+    return;
+  }
+  if (params_.publish_tf)
+  {
+    publisher_.publishMapToOdom(supported->map_to_odom);
+  }
+  if (params_.publish_initialpose && handover_pending_)
+  {
+    handover_pending_ = false;
+    publisher_.publishInitialPose(job, result.candidates.front(), *map_);
+  }
+}
+
 Outcome SolverWorker::trackBatch(const Job& job)
 {
   const auto start = std::chrono::steady_clock::now();
-  Directive directive = takeDirective(job);
+  const Directive directive = takeDirective(job);
   Outcome outcome;
   if (directive.stale)
   {
@@ -161,69 +219,27 @@ Outcome SolverWorker::trackBatch(const Job& job)
     updates_since_global_ = 0;
     was_tracking_ = false;
   }
-  std::string event;
-  try
-  {
-    if (directive.hint)
-    {
-      event = applyHint(*directive.hint, job);
-    }
-    else if (needsGlobalSearch(directive.relocalizing))
-    {
-      event = globalSearch(job);
-    }
-    else if (!tracker_->hypotheses().empty())
-    {
-      tracker_->update(job.readings, job.batch.base_first);
-      ++updates_since_global_;
-    }
-  }
-  catch (const std::exception& error)
-  {
-    event = std::string("tracking failed: ") + error.what();
-    ROS_ERROR_THROTTLE(5.0, "fdml_localizer: %s", event.c_str());
-  }
+  std::string event = stepTracker(directive, job);
   const core::TrackState track = tracker_->state();
-  const bool kidnap = was_tracking_ && track == core::TrackState::Lost;
-  if (kidnap)
-  {
-    event = solveMode(params_) == SolveMode::Continuous ?
-                "kidnap detected: every hypothesis missed " + std::to_string(params_.tracker.lost_updates) +
-                    " updates in a row; relocalizing" :
-                "track lost: every hypothesis missed " + std::to_string(params_.tracker.lost_updates) +
-                    " updates in a row; call ~relocalize";
-    ROS_WARN("fdml_localizer: %s", event.c_str());
-  }
-  const core::Hypothesis* supported = tracker_->clearlySupported();
-  was_tracking_ = supported != nullptr || (was_tracking_ && track != core::TrackState::Lost);
+  bool kidnap = false;
+  const std::string lost = lostTrackEvent(track, &kidnap);
+  event = lost.empty() ? event : lost;
   core::Result result = trackedResult(job);
   result.times.total = core::secondsSince(start);
-  outcome.success = supported != nullptr;
+  outcome.success = tracker_->clearlySupported() != nullptr;
   outcome.message = describeTracking(*tracker_, static_cast<int>(job.readings.size()));
   outcome.result = resultMessage(job, result);
   outcome.result.unambiguous = outcome.success;
   const std::vector<OutcomePromise> waiters = recordTracking(job, event, kidnap, statusOf(track), &outcome);
-  publisher_.publishBatch(job, result, outcome, outcome.success, *map_);
-  if (supported)
-  {
-    if (params_.publish_tf)
-    {
-      publisher_.publishMapToOdom(supported->map_to_odom);
-    }
-    if (params_.publish_initialpose && handover_pending_)
-    {
-      handover_pending_ = false;
-      publisher_.publishInitialPose(job, result.candidates.front(), *map_);
-    }
-  }
+  publishTracking(job, result, outcome);
   for (const OutcomePromise& waiter : waiters)
   {
     waiter->set_value(outcome);
   }
-  if (!event.empty() && !kidnap)
+  if (!event.empty())
   {
-    const bool refused = event.rfind("initialpose refused", 0) == 0;
-    ROS_LOG(refused ? ros::console::levels::Warn : ros::console::levels::Info, ROSCONSOLE_DEFAULT_NAME,
+    const bool warn = kidnap || event.rfind("initialpose refused", 0) == 0 || event.rfind("tracking failed", 0) == 0;
+    ROS_LOG(warn ? ros::console::levels::Warn : ros::console::levels::Info, ROSCONSOLE_DEFAULT_NAME,
             "fdml_localizer: %s", event.c_str());
   }
   return outcome;

@@ -81,97 +81,99 @@ geometry_msgs::PoseWithCovarianceStamped hint(double x, double y, double yaw, do
   msg.pose.covariance[35] = sigma_yaw * sigma_yaw;
   return msg;
 }
+
+/// The nodes and clients of the test.
+struct Fixture
+{
+  ros::NodeHandle nh;
+  Scorer scorer{ nh };
+  StatusRecorder status{ nh };
+  ros::Publisher initialpose = nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("initialpose", 2);
+  ros::ServiceClient kidnap = nh.serviceClient<fdml_localization::Kidnap>("fdml_simulator/kidnap");
+  ros::ServiceClient relocalize = nh.serviceClient<fdml_localization::Relocalize>("fdml_localizer/relocalize");
+
+  Pose truthNow()
+  {
+    std::lock_guard<std::mutex> lock(scorer.mutex);
+    return scorer.latest_truth;
+  }
+};
+
+/// One ~relocalize: right, then right while the robot drives on for 30 s.
+void relocalizeAndDrive(Fixture& f)
+{
+  fdml_localization::Relocalize srv;
+  srv.request.timeout = 30.0;
+  ASSERT_TRUE(f.relocalize.call(srv));
+  ASSERT_TRUE(srv.response.success) << srv.response.message;
+  ASSERT_TRUE(srv.response.result.unambiguous);
+  double start = 0.0;
+  {
+    std::lock_guard<std::mutex> lock(f.scorer.mutex);
+    Pose truth;
+    ASSERT_TRUE(f.scorer.truthAt(srv.response.result.header.stamp, &truth));
+    const auto& best = srv.response.result.candidates.at(0).pose;
+    EXPECT_LT(std::hypot(best.position.x - truth.x, best.position.y - truth.y), 0.1) << srv.response.message;
+    f.scorer.restartCounts();
+    start = f.scorer.now;
+  }
+  ASSERT_TRUE(waitFor(
+      [&] {
+        std::lock_guard<std::mutex> lock(f.scorer.mutex);
+        return f.scorer.now > start + 30.0;
+      },
+      60.0));
+  std::lock_guard<std::mutex> lock(f.scorer.mutex);
+  const double right = static_cast<double>(f.scorer.right_after_fix) / std::max(1, f.scorer.samples_after_fix);
+  ROS_INFO("on_request: after one ~relocalize, right %.1f %%, wrong %d of %d samples over 30 s", 100.0 * right,
+           f.scorer.wrong_after_fix, f.scorer.samples_after_fix);
+  EXPECT_GE(right, 0.9);
+  EXPECT_LE(f.scorer.wrong_after_fix, f.scorer.samples_after_fix / 50);
+}
+
+/// A kidnap: the track is reported lost; a hint 5 m off is refused, one near the truth accepted.
+void kidnapAndHints(Fixture& f)
+{
+  fdml_localization::Kidnap move;
+  move.request.pose.x = 4.0;
+  move.request.pose.y = 3.0;
+  ASSERT_TRUE(f.kidnap.call(move));
+  ASSERT_TRUE(move.response.success) << move.response.message;
+  EXPECT_TRUE(waitFor([&] { return f.status.seen([](const auto& s) { return s.state == s.LOST; }); }, 20.0));
+  Pose truth = f.truthNow();
+  f.initialpose.publish(hint(truth.x + 4.0, truth.y + 3.0, truth.yaw, 0.1, 0.05));
+  EXPECT_TRUE(waitFor(
+      [&] { return f.status.seen([](const auto& s) { return s.message.find("initialpose refused") == 0; }); }, 20.0));
+  truth = f.truthNow();
+  f.initialpose.publish(hint(truth.x + 0.15, truth.y - 0.1, truth.yaw + 0.1, 0.2, 0.1));
+  EXPECT_TRUE(waitFor([&] { return f.status.seen([](const auto& s) { return s.state == s.TRACKING; }); }, 20.0));
+  int right_before = 0;
+  {
+    std::lock_guard<std::mutex> lock(f.scorer.mutex);
+    right_before = f.scorer.right;
+  }
+  EXPECT_TRUE(waitFor(
+      [&] {
+        std::lock_guard<std::mutex> lock(f.scorer.mutex);
+        return f.scorer.right > right_before + 5;
+      },
+      20.0))
+      << "the pose was not right again after the hint";
+}
 }  // namespace
 
 TEST(TrackingRequests, RelocalizeThenTrackKidnapAndHints)
 {
-  ros::NodeHandle nh;
-  Scorer scorer(nh);
-  StatusRecorder status(nh);
-  ros::Publisher initialpose = nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("initialpose", 2);
-  ros::ServiceClient kidnap = nh.serviceClient<fdml_localization::Kidnap>("fdml_simulator/kidnap");
-  ros::ServiceClient relocalize = nh.serviceClient<fdml_localization::Relocalize>("fdml_localizer/relocalize");
-  ASSERT_TRUE(kidnap.waitForExistence(ros::Duration(60.0)));
-  ASSERT_TRUE(relocalize.waitForExistence(ros::Duration(60.0)));
-
+  Fixture f;
+  ASSERT_TRUE(f.kidnap.waitForExistence(ros::Duration(60.0)));
+  ASSERT_TRUE(f.relocalize.waitForExistence(ros::Duration(60.0)));
   fdml_localization::Relocalize absurd;
   absurd.request.timeout = 1e308;
-  ASSERT_TRUE(relocalize.call(absurd));
+  ASSERT_TRUE(f.relocalize.call(absurd));
   EXPECT_FALSE(absurd.response.success);
   EXPECT_NE(absurd.response.message.find("out of range"), std::string::npos) << absurd.response.message;
-
-  fdml_localization::Relocalize srv;
-  srv.request.timeout = 30.0;
-  ASSERT_TRUE(relocalize.call(srv));
-  ASSERT_TRUE(srv.response.success) << srv.response.message;
-  ASSERT_TRUE(srv.response.result.unambiguous);
-  {
-    std::lock_guard<std::mutex> lock(scorer.mutex);
-    Pose truth;
-    ASSERT_TRUE(scorer.truthAt(srv.response.result.header.stamp, &truth));
-    const auto& best = srv.response.result.candidates.at(0).pose;
-    EXPECT_LT(std::hypot(best.position.x - truth.x, best.position.y - truth.y), 0.1) << srv.response.message;
-    scorer.restartCounts();
-  }
-  // The answer stays right while the robot drives on for 30 s.
-  double start = 0.0;
-  ASSERT_TRUE(waitFor(
-      [&] {
-        std::lock_guard<std::mutex> lock(scorer.mutex);
-        start = scorer.now;
-        return start > 0.0;
-      },
-      10.0));
-  ASSERT_TRUE(waitFor(
-      [&] {
-        std::lock_guard<std::mutex> lock(scorer.mutex);
-        return scorer.now > start + 30.0;
-      },
-      60.0));
-  {
-    std::lock_guard<std::mutex> lock(scorer.mutex);
-    const double right = static_cast<double>(scorer.right_after_fix) / std::max(1, scorer.samples_after_fix);
-    ROS_INFO("on_request: after one ~relocalize, right %.1f %%, wrong %d of %d samples over 30 s", 100.0 * right,
-             scorer.wrong_after_fix, scorer.samples_after_fix);
-    EXPECT_GE(right, 0.9);
-    EXPECT_LE(scorer.wrong_after_fix, scorer.samples_after_fix / 50);
-  }
-
-  // A kidnap: the track is reported lost, the pose withdrawn.
-  fdml_localization::Kidnap move;
-  move.request.pose.x = 4.0;
-  move.request.pose.y = 3.0;
-  ASSERT_TRUE(kidnap.call(move));
-  ASSERT_TRUE(move.response.success) << move.response.message;
-  EXPECT_TRUE(waitFor([&] { return status.seen([](const auto& s) { return s.state == s.LOST; }); }, 20.0));
-
-  // A hint 4 m off is refused; a hint near the truth brings the pose back.
-  Pose truth;
-  {
-    std::lock_guard<std::mutex> lock(scorer.mutex);
-    truth = scorer.latest_truth;
-  }
-  initialpose.publish(hint(truth.x + 4.0, truth.y + 3.0, truth.yaw, 0.1, 0.05));
-  EXPECT_TRUE(waitFor(
-      [&] { return status.seen([](const auto& s) { return s.message.find("initialpose refused") == 0; }); }, 20.0));
-  {
-    std::lock_guard<std::mutex> lock(scorer.mutex);
-    truth = scorer.latest_truth;
-  }
-  initialpose.publish(hint(truth.x + 0.15, truth.y - 0.1, truth.yaw + 0.1, 0.2, 0.1));
-  EXPECT_TRUE(waitFor([&] { return status.seen([](const auto& s) { return s.state == s.TRACKING; }); }, 20.0));
-  int right_before = 0;
-  {
-    std::lock_guard<std::mutex> lock(scorer.mutex);
-    right_before = scorer.right;
-  }
-  EXPECT_TRUE(waitFor(
-      [&] {
-        std::lock_guard<std::mutex> lock(scorer.mutex);
-        return scorer.right > right_before + 5;
-      },
-      20.0))
-      << "the pose was not right again after the hint";
+  relocalizeAndDrive(f);
+  kidnapAndHints(f);
 }
 
 int main(int argc, char** argv)

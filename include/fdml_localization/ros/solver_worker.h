@@ -76,6 +76,12 @@ private:
   Directive takeDirective(const Job& job);
   /// A sensor batch: a hint, a global search or a tracking update, then publishing.
   Outcome trackBatch(const Job& job);
+  /// A hint, a global search or a tracking update on @p job; the event to report (empty: none).
+  std::string stepTracker(const Directive& directive, const Job& job);
+  /// The event of a track lost since the last batch (sets @p kidnap), or empty.
+  std::string lostTrackEvent(core::TrackState track, bool* kidnap);
+  /// ~result, ~candidates, markers; ~pose, map -> odom and the hand-over while clearly supported.
+  void publishTracking(const Job& job, const core::Result& result, const Outcome& outcome);
   /// True when this batch needs a global search (docs/localizer_node.md#tracking).
   bool needsGlobalSearch(bool relocalizing) const;
   /// Runs the global search on @p job and seeds the tracker with its candidates.

@@ -26,26 +26,7 @@ namespace core = fdml_localization::core;
 
 std::vector<fdml_test::DriveBatch> patrolBatches(const std::shared_ptr<const core::MapRayCaster>& map, int k)
 {
-  core::ScenarioConfig c;
-  c.seed = 5;
-  c.step_rate = 50;
-  c.robot.radius = 0.18;
-  c.robot.random_start = false;
-  c.robot.start = core::Pose2(1.5, 1.0, 0.0);
-  c.robot.motion = core::RobotMotion::Waypoints;
-  c.robot.linear_speed = 0.4;
-  c.robot.angular_speed = 0.8;
-  c.robot.waypoints = { { 1.5, 1.0 },  { 5.5, 1.0 },  { 5.5, 2.0 }, { 8.3, 2.0 }, { 8.3, 3.3 },
-                        { 11.3, 3.3 }, { 11.3, 0.8 }, { 8.3, 0.8 }, { 8.3, 2.0 }, { 2.8, 2.0 } };
-  c.sensors = fdml_test::fourSensors(10.0, 8.0, 0.01);
-  c.odometry.rate = 50;
-  c.odometry.translation_noise = 0.03;
-  c.odometry.rotation_noise = 0.03;
-  core::ObstacleGroupConfig people;
-  people.count = 5;
-  people.radius = 0.25;
-  people.motion = core::ObstacleMotion::RandomWalk;
-  c.obstacles.push_back(people);
+  const core::ScenarioConfig c = fdml_test::apartmentPatrol(5);
   std::vector<std::string> errors;
   fdml_test::Drive drive(core::Simulation::create(c, map, &errors), k, 2);
   std::vector<fdml_test::DriveBatch> batches;

@@ -7,6 +7,7 @@
 #include "fdml_localization/simulation/simulation.h"
 
 #include <cmath>
+#include <cstdint>
 #include <deque>
 #include <memory>
 #include <vector>
@@ -126,6 +127,64 @@ inline std::vector<core::SensorConfig> fourSensors(double rate, double max_range
     sensors.push_back(s);
   }
   return sensors;
+}
+
+/// A robot driving a loop of @p waypoints (starting at the first) at 0.4 m/s with fourSensors(10 Hz,
+/// @p max_range, 1 cm noise) and odometry drifting by @p drift per metre and per radian.
+inline core::ScenarioConfig waypointScenario(std::vector<core::Vec2> waypoints, double max_range, double drift,
+                                             std::uint64_t seed)
+{
+  core::ScenarioConfig c;
+  c.seed = seed;
+  c.step_rate = 50;
+  c.robot.radius = 0.18;
+  c.robot.random_start = false;
+  c.robot.start = core::Pose2(waypoints.front().x(), waypoints.front().y(), 0.0);
+  c.robot.motion = core::RobotMotion::Waypoints;
+  c.robot.linear_speed = 0.4;
+  c.robot.angular_speed = 0.8;
+  c.robot.waypoints = std::move(waypoints);
+  c.sensors = fourSensors(10.0, max_range, 0.01);
+  c.odometry.rate = 50;
+  c.odometry.translation_noise = drift;
+  c.odometry.rotation_noise = drift;
+  return c;
+}
+
+/// The apartment patrol (config/scenarios/apartment_patrol.yaml): four rooms through their doors,
+/// 3 % odometry drift, @p people walking at random.
+inline core::ScenarioConfig apartmentPatrol(int people)
+{
+  core::ScenarioConfig c = waypointScenario({ { 1.5, 1.0 },
+                                              { 5.5, 1.0 },
+                                              { 5.5, 2.0 },
+                                              { 8.3, 2.0 },
+                                              { 8.3, 3.3 },
+                                              { 11.3, 3.3 },
+                                              { 11.3, 0.8 },
+                                              { 8.3, 0.8 },
+                                              { 8.3, 2.0 },
+                                              { 2.8, 2.0 },
+                                              { 2.8, 5.7 },
+                                              { 8.0, 5.7 },
+                                              { 8.0, 7.5 },
+                                              { 10.5, 7.5 },
+                                              { 10.5, 5.0 },
+                                              { 8.0, 5.0 },
+                                              { 8.0, 5.7 },
+                                              { 2.8, 5.7 },
+                                              { 2.8, 2.0 } },
+                                            8.0, 0.03, 5);
+  if (people > 0)
+  {
+    core::ObstacleGroupConfig g;
+    g.count = people;
+    g.radius = 0.25;
+    g.motion = core::ObstacleMotion::RandomWalk;
+    g.speed = 0.5;
+    c.obstacles.push_back(g);
+  }
+  return c;
 }
 
 }  // namespace fdml_test

@@ -23,44 +23,11 @@ std::shared_ptr<const core::MapRayCaster> apartment()
                                                                                                       "poly"));
 }
 
-/// The apartment patrol: waypoints through four rooms, drifting odometry, optionally people.
-core::ScenarioConfig patrol(int people)
-{
-  core::ScenarioConfig c;
-  c.seed = 5;
-  c.step_rate = 50;
-  c.robot.radius = 0.18;
-  c.robot.random_start = false;
-  c.robot.motion = core::RobotMotion::Waypoints;
-  c.robot.linear_speed = 0.4;
-  c.robot.angular_speed = 0.8;
-  c.robot.waypoints = { { 1.5, 1.0 },  { 5.5, 1.0 },  { 5.5, 2.0 }, { 8.3, 2.0 },  { 8.3, 3.3 },
-                        { 11.3, 3.3 }, { 11.3, 0.8 }, { 8.3, 0.8 }, { 8.3, 2.0 },  { 2.8, 2.0 },
-                        { 2.8, 5.7 },  { 8.0, 5.7 },  { 8.0, 7.5 }, { 10.5, 7.5 }, { 10.5, 5.0 },
-                        { 8.0, 5.0 },  { 8.0, 5.7 },  { 2.8, 5.7 }, { 2.8, 2.0 } };
-  c.sensors = fdml_test::fourSensors(10.0, 8.0, 0.01);
-  c.odometry.rate = 50;
-  c.odometry.translation_noise = 0.03;
-  c.odometry.rotation_noise = 0.03;
-  if (people > 0)
-  {
-    core::ObstacleGroupConfig g;
-    g.count = people;
-    g.radius = 0.25;
-    g.motion = core::ObstacleMotion::RandomWalk;
-    g.speed = 0.5;
-    c.obstacles.push_back(g);
-  }
-  return c;
-}
-
 std::unique_ptr<core::Simulation> simulate(const core::ScenarioConfig& config,
                                            std::shared_ptr<const core::MapRayCaster> map)
 {
   std::vector<std::string> errors;
-  core::ScenarioConfig c = config;
-  c.robot.start = core::Pose2(c.robot.waypoints.front().x(), c.robot.waypoints.front().y(), 0.0);
-  auto sim = core::Simulation::create(c, std::move(map), &errors);
+  auto sim = core::Simulation::create(config, std::move(map), &errors);
   if (!errors.empty())
   {
     ADD_FAILURE() << errors.front();
@@ -93,7 +60,7 @@ core::TrackerOptions options()
 TEST(HypothesisTracker, CarriedByOdometryAmongPeople)
 {
   const auto map = apartment();
-  Drive drive(simulate(patrol(5), map), 10, 2);
+  Drive drive(simulate(fdml_test::apartmentPatrol(5), map), 10, 2);
   core::HypothesisTracker tracker(map, options());
   DriveBatch batch;
   ASSERT_TRUE(drive.next(&batch, 60.0));
@@ -125,7 +92,7 @@ TEST(HypothesisTracker, CarriedByOdometryAmongPeople)
 TEST(HypothesisTracker, LoneWeakHypothesisIsNotClearlySupported)
 {
   const auto map = apartment();
-  Drive drive(simulate(patrol(0), map), 10, 2);
+  Drive drive(simulate(fdml_test::apartmentPatrol(0), map), 10, 2);
   core::HypothesisTracker tracker(map, options());
   DriveBatch batch;
   ASSERT_TRUE(drive.next(&batch, 10.0));
@@ -147,7 +114,7 @@ TEST(HypothesisTracker, LoneWeakHypothesisIsNotClearlySupported)
 TEST(HypothesisTracker, KidnapIsDetectedAndNeverPublishedLong)
 {
   const auto map = apartment();
-  Drive drive(simulate(patrol(3), map), 10, 2);
+  Drive drive(simulate(fdml_test::apartmentPatrol(3), map), 10, 2);
   core::HypothesisTracker tracker(map, options());
   DriveBatch batch;
   ASSERT_TRUE(drive.next(&batch, 20.0));
@@ -191,21 +158,21 @@ core::PolygonMap twinRooms()
 TEST(HypothesisTracker, TwinRoomsStayAmbiguousUntilTheRobotLeaves)
 {
   const auto map = std::make_shared<const core::MapRayCaster>(twinRooms());
-  core::ScenarioConfig c;
-  c.seed = 3;
-  c.step_rate = 50;
-  c.robot.radius = 0.15;
-  c.robot.random_start = false;
-  c.robot.motion = core::RobotMotion::Waypoints;
-  c.robot.linear_speed = 0.4;
-  c.robot.angular_speed = 0.8;
   // Twice round the left room, then out through the door to the corridor's left end.
-  c.robot.waypoints = { { 1.0, 1.0 }, { 3.0, 1.0 }, { 3.0, 2.6 },  { 1.0, 2.6 },  { 1.0, 1.0 },  { 3.0, 1.0 },
-                        { 3.0, 2.6 }, { 2.0, 2.6 }, { 2.0, 4.95 }, { 0.6, 4.95 }, { 2.0, 4.95 }, { 2.0, 2.6 } };
-  c.sensors = fdml_test::fourSensors(10.0, 2.5, 0.01);
-  c.odometry.rate = 50;
-  c.odometry.translation_noise = 0.02;
-  c.odometry.rotation_noise = 0.02;
+  core::ScenarioConfig c = fdml_test::waypointScenario({ { 1.0, 1.0 },
+                                                         { 3.0, 1.0 },
+                                                         { 3.0, 2.6 },
+                                                         { 1.0, 2.6 },
+                                                         { 1.0, 1.0 },
+                                                         { 3.0, 1.0 },
+                                                         { 3.0, 2.6 },
+                                                         { 2.0, 2.6 },
+                                                         { 2.0, 4.95 },
+                                                         { 0.6, 4.95 },
+                                                         { 2.0, 4.95 },
+                                                         { 2.0, 2.6 } },
+                                                       2.5, 0.02, 3);
+  c.robot.radius = 0.15;
   Drive drive(simulate(c, map), 10, 2);
   core::HypothesisTracker tracker(map, options());
   DriveBatch batch;

@@ -59,7 +59,10 @@ SolverWorker::Directive SolverWorker::takeDirective(const Job& job)
     generation_ = job.generation;
   }
   d.relocalizing = state_.relocalizing;
-  d.hint.swap(state_.pending_hint);
+  if (!d.stale)
+  {
+    d.hint.swap(state_.pending_hint);  // a stale batch leaves the hint for the next one
+  }
   return d;
 }
 

@@ -189,7 +189,13 @@ std::string SolverWorker::lostTrackEvent(core::TrackState track, bool* kidnap)
 
 void SolverWorker::publishTracking(const Job& job, const core::Result& result, const Outcome& outcome)
 {
-  publisher_.publishBatch(job, result, outcome, outcome.success, *map_);
+  // Without hypotheses (on_request mode before a request, or lost) one empty result says so.
+  const bool empty = result.candidates.empty();
+  if (!empty || !published_empty_)
+  {
+    publisher_.publishBatch(job, result, outcome, outcome.success, *map_);
+  }
+  published_empty_ = empty;
   const core::Hypothesis* supported = tracker_->clearlySupported();
   if (!supported)
   {

@@ -105,6 +105,7 @@ private:
   std::uint64_t generation_ = 0;                      ///< NodeState::generation of the last batch
   int updates_since_global_ = 0;                      ///< tracking updates since the last global search
   bool handover_pending_ = false;                     ///< ~publish_initialpose: a relocalization awaits its fix
+  bool published_empty_ = false;                      ///< the last ~result published had no hypothesis
   bool was_tracking_ = false;                         ///< the last batch had a clearly supported hypothesis
   std::thread thread_;
 };

@@ -8,6 +8,17 @@
 
 namespace fdml_localization
 {
+namespace
+{
+/// Batches slide in both modes: the tracker follows every batch after a relocalization.
+ReadingBuffer::Options trackingBufferOptions(const Params& params)
+{
+  ReadingBuffer::Options options = bufferOptions(params);
+  options.continuous = true;
+  return options;
+}
+}  // namespace
+
 LocalizerNode::LocalizerNode(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh, const Params& params,
                              const LoadedMap& map)
   : params_(params)
@@ -17,14 +28,17 @@ LocalizerNode::LocalizerNode(const ros::NodeHandle& nh, const ros::NodeHandle& p
   , global_service_nh_(nh)
   , tf_listener_(tf_buffer_)
   , diagnostics_(nh, private_nh)
-  , state_(bufferOptions(params_))
-  , publisher_(private_nh_, params_)
+  , state_(trackingBufferOptions(params_))
+  , publisher_(nh_, private_nh_, params_)
   , input_(nh_, params_, state_, tf_buffer_)
 {
   const std::string map_topic = nh_.resolveName("map");
   worker_.reset(new SolverWorker(params_, state_, publisher_, map, map_topic));
   state_.have_map = static_cast<bool>(map.map);
   state_.map_source = map.source;
+  // Continuous mode localizes from the start; on_request mode waits for a request or a hint.
+  state_.relocalizing = solveMode(params_) == SolveMode::Continuous;
+  initialpose_sub_ = nh_.subscribe("initialpose", 2, &LocalizerNode::initialPoseCallback, this);
   if (params_.use_map_topic)
   {
     // The callback only stores the message: the worker converts it between two solves.
@@ -45,6 +59,7 @@ LocalizerNode::LocalizerNode(const ros::NodeHandle& nh, const ros::NodeHandle& p
   service_spinner_.reset(new ros::AsyncSpinner(2, &service_queue_));
   service_spinner_->start();
   process_timer_ = nh_.createWallTimer(ros::WallDuration(0.02), &LocalizerNode::processTimer, this);
+  status_timer_ = nh_.createWallTimer(ros::WallDuration(0.5), &LocalizerNode::statusTimer, this);
   if (params_.publish_tf)
   {
     tf_timer_ = nh_.createWallTimer(ros::WallDuration(1.0 / params_.tf_publish_rate), &LocalizerNode::tfTimer, this);
@@ -62,6 +77,7 @@ LocalizerNode::~LocalizerNode()
   }
   state_.work_ready.notify_all();
   process_timer_.stop();
+  status_timer_.stop();
   tf_timer_.stop();
   worker_.reset();  // joins the worker thread
   service_spinner_->stop();
@@ -71,6 +87,46 @@ void LocalizerNode::processTimer(const ros::WallTimerEvent& /*event*/)
 {
   input_.process();
   diagnostics_.update();
+}
+
+void LocalizerNode::statusTimer(const ros::WallTimerEvent& /*event*/)
+{
+  fdml_localization::Status status;
+  {
+    std::lock_guard<std::mutex> lock(state_.mutex);
+    status = state_.statusLocked();
+  }
+  publisher_.publishStatus(status);
+}
+
+void LocalizerNode::initialPoseCallback(const ros::MessageEvent<const geometry_msgs::PoseWithCovarianceStamped>& event)
+{
+  if (event.getPublisherName() == ros::this_node::getName())
+  {
+    return;  // our own hand-over (~publish_initialpose)
+  }
+  const geometry_msgs::PoseWithCovarianceStamped& msg = *event.getConstMessage();
+  PoseHint hint;
+  hint.pose = fromPoseMsg(msg.pose.pose);
+  const int index[3] = { 0, 1, 5 };  // x, y, yaw in the 6 x 6 covariance
+  for (int r = 0; r < 3; ++r)
+  {
+    for (int c = 0; c < 3; ++c)
+    {
+      hint.covariance(r, c) = msg.pose.covariance[6 * index[r] + index[c]];
+    }
+  }
+  if (!std::isfinite(hint.pose.x) || !std::isfinite(hint.pose.y) || !std::isfinite(hint.pose.theta) ||
+      (!msg.header.frame_id.empty() && msg.header.frame_id != params_.global_frame_id))
+  {
+    ROS_WARN("fdml_localizer: initialpose ignored: a non-finite pose or a frame other than %s (got \"%s\")",
+             params_.global_frame_id.c_str(), msg.header.frame_id.c_str());
+    return;
+  }
+  std::lock_guard<std::mutex> lock(state_.mutex);
+  state_.pending_hint = hint;
+  ROS_INFO("fdml_localizer: initialpose (%.2f, %.2f, %.2f) received: checked against the next batch", hint.pose.x,
+           hint.pose.y, hint.pose.theta);
 }
 
 void LocalizerNode::tfTimer(const ros::WallTimerEvent& /*event*/)
@@ -115,21 +171,9 @@ std::string LocalizerNode::refusalLocked() const
 
 void LocalizerNode::startRelocalizationLocked(const OutcomePromise& waiter)
 {
-  if (solveMode(params_) == SolveMode::OnRequest)
-  {
-    state_.buffer.requestBatch();
-  }
-  else
-  {
-    state_.buffer.clear();
-  }
-  if (state_.queued_batch)
-  {
-    // A batch formed before the request is stale: its waiters move on to the fresh batch.
-    state_.relocalize_waiters.insert(state_.relocalize_waiters.end(), state_.queued_batch->waiters.begin(),
-                                     state_.queued_batch->waiters.end());
-    state_.queued_batch.reset();
-  }
+  // Fresh readings only: a batch formed before the request is stale.
+  state_.buffer.clear();
+  state_.queued_batch.reset();
   if (waiter)
   {
     state_.relocalize_waiters.push_back(waiter);
@@ -137,14 +181,24 @@ void LocalizerNode::startRelocalizationLocked(const OutcomePromise& waiter)
   // The robot may have been kidnapped: stop vouching for the old map -> odom, and let no batch
   // formed before this request (perhaps being solved right now) bring it back.
   state_.have_map_to_odom = false;
+  state_.relocalizing = true;
   ++state_.generation;
   state_.activity = "relocalizing: waiting for " + std::to_string(params_.measurements_per_batch) + " fresh readings";
+  state_.tracking.message = state_.activity;
 }
 
 bool LocalizerNode::relocalizeService(fdml_localization::Relocalize::Request& req,
                                       fdml_localization::Relocalize::Response& res)
 {
-  const double timeout = req.timeout > 0.0 && std::isfinite(req.timeout) ? req.timeout : params_.relocalize_timeout;
+  if (!(req.timeout >= 0.0 && req.timeout <= kMaxRelocalizeTimeout))
+  {
+    res.success = false;
+    res.message = "timeout = " + std::to_string(req.timeout) +
+                  " is out of range; allowed: 0 (~relocalize_timeout) or "
+                  "(0, 3600] s";
+    return true;
+  }
+  const double timeout = req.timeout > 0.0 ? req.timeout : params_.relocalize_timeout;
   auto waiter = std::make_shared<std::promise<Outcome>>();
   std::future<Outcome> future = waiter->get_future();
   {
@@ -157,19 +211,19 @@ bool LocalizerNode::relocalizeService(fdml_localization::Relocalize::Request& re
     }
     startRelocalizationLocked(waiter);
   }
-  ROS_INFO("fdml_localizer: relocalizing: waiting up to %g s for %d fresh readings (rotate the robot in place or "
-           "sweep the sensors)",
-           timeout, params_.measurements_per_batch);
+  ROS_INFO("fdml_localizer: relocalizing: waiting up to %g s until one hypothesis is clearly supported (drive or "
+           "rotate the robot, or sweep the sensors)",
+           timeout);
   if (future.wait_for(std::chrono::duration<double>(timeout)) != std::future_status::ready)
   {
     std::lock_guard<std::mutex> lock(state_.mutex);
     res.success = false;
-    res.message = "timed out after " + std::to_string(timeout) +
-                  " s: " + std::to_string(state_.buffer.resolvedCount()) + " of " +
-                  std::to_string(params_.measurements_per_batch) + " readings ready, " +
+    res.message = "timed out after " + std::to_string(timeout) + " s: " + state_.tracking.message + "; " +
+                  std::to_string(state_.buffer.resolvedCount()) + " readings ready, " +
                   std::to_string(state_.buffer.pendingCount()) +
-                  " waiting for tf (publish range/scan readings and tf while the robot rotates in place or the "
-                  "sensors sweep; the result will still be published on ~result when the batch completes)";
+                  " waiting for tf (publish range/scan readings and tf while the robot drives or rotates in place or "
+                  "the sensors sweep; the relocalization goes on: ~pose and map -> odom follow once one hypothesis is "
+                  "clearly supported)";
     return true;
   }
   const Outcome outcome = future.get();
@@ -215,9 +269,7 @@ bool LocalizerNode::globalLocalizationService(std_srvs::Empty::Request& /*req*/,
     return true;
   }
   startRelocalizationLocked(nullptr);
-  ROS_INFO("fdml_localizer: global localization started: waiting for %d fresh readings (rotate the robot in place "
-           "or sweep the sensors)",
-           params_.measurements_per_batch);
+  ROS_INFO("fdml_localizer: global localization started (drive or rotate the robot, or sweep the sensors)");
   return true;
 }
 

@@ -19,22 +19,21 @@ void summarize(const NodeState& state, diagnostic_updater::DiagnosticStatusWrapp
   {
     status.summary(DiagnosticStatus::OK, "no batch solved yet (" + state.activity + ")");
   }
-  else if (!stats.last_error.empty() && stats.last_candidates == 0)
+  else if (state.relocalizing)
   {
-    status.summary(DiagnosticStatus::ERROR, stats.last_error);
+    status.summary(DiagnosticStatus::WARN, "relocalizing: " + state.tracking.message);
   }
-  else if (stats.last_candidates == 0)
+  else if (state.tracking.state == fdml_localization::Status::TRACKING)
   {
-    status.summary(DiagnosticStatus::WARN, "no pose explains the last batch");
+    status.summary(DiagnosticStatus::OK, "tracking: " + state.tracking.message);
   }
-  else if (!stats.last_unambiguous)
+  else if (state.tracking.state == fdml_localization::Status::AMBIGUOUS)
   {
-    status.summary(DiagnosticStatus::WARN,
-                   "ambiguous: " + std::to_string(stats.last_candidates) + " candidates tie on the best net consensus");
+    status.summary(DiagnosticStatus::WARN, "ambiguous (no pose published): " + state.tracking.message);
   }
   else
   {
-    status.summary(DiagnosticStatus::OK, "localized");
+    status.summary(DiagnosticStatus::WARN, "lost (no pose published): " + state.tracking.message);
   }
 }
 }  // namespace
@@ -54,11 +53,18 @@ void diagnoseLocked(const NodeState& state, const Params& params, diagnostic_upd
   status.add("sensor frames evicted", state.buffer.framesEvicted());
   status.add("readings waiting for tf", state.buffer.pendingCount());
   status.add("readings ready", state.buffer.resolvedCount());
-  status.add("batches solved", stats.batches_solved);
+  status.add("batches tracked", stats.batches_solved);
   status.add("batches replaced before solving", stats.batches_replaced);
   status.add("solver errors", stats.solve_errors);
-  status.add("last solve time [s]", stats.last_solve_time);
-  status.add("candidates", stats.last_candidates);
+  status.add("last update time [s]", stats.last_solve_time);
+  const fdml_localization::Status tracking = state.statusLocked();
+  status.add("tracking state", tracking.state_name);
+  status.add("hypotheses", tracking.hypotheses);
+  status.add("best support", tracking.best_support);
+  status.add("second support", tracking.second_support);
+  status.add("readings since the last update", tracking.readings_since_update);
+  status.add("kidnaps detected", tracking.kidnaps_detected);
+  status.add("global searches", tracking.global_searches);
   status.add("map", state.have_map ? state.map_source : std::string("(none yet)"));
   if (params.use_map_topic)
   {

@@ -1,19 +1,38 @@
 #include "fdml_localization/ros/node_state.h"
 
+#include <ros/time.h>
+
+#include <algorithm>
 #include <utility>
 
 namespace fdml_localization
 {
 void NodeState::queueBatchLocked(std::unique_ptr<Job> job)
 {
-  job->waiters.swap(relocalize_waiters);
+  // Relocalization waiters stay in relocalize_waiters until a hypothesis is clearly supported.
   if (queued_batch)
   {
-    // A newer batch replaces the queued one and inherits its waiters.
-    ++stats.batches_replaced;
-    job->waiters.insert(job->waiters.end(), queued_batch->waiters.begin(), queued_batch->waiters.end());
+    ++stats.batches_replaced;  // a newer batch replaces the queued one
   }
   queued_batch = std::move(job);
+}
+
+fdml_localization::Status NodeState::statusLocked() const
+{
+  fdml_localization::Status msg;
+  msg.header.stamp = ros::Time::now();
+  msg.state = relocalizing ? static_cast<std::uint8_t>(fdml_localization::Status::RELOCALIZING) : tracking.state;
+  static const char* const kNames[] = { "tracking", "ambiguous", "lost", "relocalizing" };
+  msg.state_name = msg.state < 4 ? kNames[msg.state] : "unknown";
+  msg.message = tracking.message;
+  msg.hypotheses = static_cast<std::uint32_t>(tracking.hypotheses);
+  msg.best_support = tracking.best_support;
+  msg.second_support = tracking.second_support;
+  const std::uint64_t since = buffer.received() - std::min(buffer.received(), tracking.received_at_update);
+  msg.readings_since_update = static_cast<std::uint32_t>(std::min<std::uint64_t>(since, 0xffffffffu));
+  msg.kidnaps_detected = static_cast<std::uint32_t>(std::min<std::uint64_t>(tracking.kidnaps_detected, 0xffffffffu));
+  msg.global_searches = static_cast<std::uint32_t>(std::min<std::uint64_t>(tracking.global_searches, 0xffffffffu));
+  return msg;
 }
 
 void NodeState::failAllWaitersLocked(const std::string& message)

@@ -54,6 +54,50 @@ bool finiteIn(double value, double lo, double hi)
   return std::isfinite(value) && value >= lo && value <= hi;
 }
 
+/// The parameter of a core::TrackerOptions field: the box options are ~tracking_*.
+std::string trackerParameterName(const std::string& option)
+{
+  const bool box = option.rfind("box_", 0) == 0 || option.rfind("cell_", 0) == 0 || option == "max_seeds" ||
+                   option.rfind("merge_", 0) == 0;
+  return (box ? "~tracking_" : "~") + option;
+}
+
+/// Reads the tracking parameters (core::TrackerOptions, ~global_interval, ~publish_initialpose).
+void readTrackingParams(ParamReader& r, Params* p)
+{
+  core::TrackerOptions& t = p->tracker;
+  const std::pair<const char*, double*> reals[] = { { "min_consensus_fraction", &t.min_consensus_fraction },
+                                                    { "odom_alpha1", &t.odom_alpha1 },
+                                                    { "odom_alpha2", &t.odom_alpha2 },
+                                                    { "odom_alpha3", &t.odom_alpha3 },
+                                                    { "odom_alpha4", &t.odom_alpha4 },
+                                                    { "support_decay", &t.support_decay },
+                                                    { "min_support", &t.min_support },
+                                                    { "support_margin", &t.support_margin },
+                                                    { "tracking_box_min_xy", &t.box_min_xy },
+                                                    { "tracking_box_min_theta", &t.box_min_theta },
+                                                    { "tracking_box_max_xy", &t.box_max_xy },
+                                                    { "tracking_box_max_theta", &t.box_max_theta },
+                                                    { "tracking_cell_xy", &t.cell_xy },
+                                                    { "tracking_cell_theta", &t.cell_theta },
+                                                    { "tracking_merge_distance", &t.merge_distance },
+                                                    { "tracking_merge_angle", &t.merge_angle } };
+  for (const auto& real : reals)
+  {
+    r.read(real.first, real.second);
+  }
+  const std::pair<const char*, int*> integers[] = {
+    { "tolerated_misses", &t.tolerated_misses }, { "max_misses", &t.max_misses },
+    { "lost_updates", &t.lost_updates },         { "max_hypotheses", &t.max_hypotheses },
+    { "tracking_max_seeds", &t.max_seeds },      { "global_interval", &p->global_interval }
+  };
+  for (const auto& integer : integers)
+  {
+    r.read(integer.first, integer.second);
+  }
+  r.read("publish_initialpose", &p->publish_initialpose);
+}
+
 bool validFrame(const std::string& frame)
 {
   return !frame.empty() && frame.find_first_of(" \t\n") == std::string::npos;
@@ -160,6 +204,17 @@ void validateCoreParams(const Params& p, std::vector<std::string>* errors)
     errors->push_back(error);
   }
 }
+
+void validateTrackingParams(const Params& p, std::vector<std::string>* errors)
+{
+  // The core's one validation of the tracker options, under the parameters' names.
+  for (const std::string& error : core::validate(p.tracker, trackerParameterName))
+  {
+    errors->push_back(error);
+  }
+  check(errors, p.global_interval >= 1 && p.global_interval <= 1000000, "global_interval", p.global_interval,
+        "an integer in [1, 1000000]");
+}
 }  // namespace
 
 std::vector<std::string> validate(const Params& p)
@@ -169,6 +224,7 @@ std::vector<std::string> validate(const Params& p)
   validateInputParams(p, &errors);
   validateFrameParams(p, &errors);
   validateCoreParams(p, &errors);
+  validateTrackingParams(p, &errors);
   return errors;
 }
 
@@ -271,7 +327,13 @@ std::string describe(const Params& p)
       << "\n"
       << "  max_candidates: " << p.localizer.max_candidates << ", threads: " << p.localizer.threads
       << ", max_boxes: " << p.localizer.max_boxes << ", deadline: " << p.localizer.deadline << " s\n"
-      << "  cache_dir: " << (p.localizer.cache_dir.empty() ? "(none)" : p.localizer.cache_dir);
+      << "  cache_dir: " << (p.localizer.cache_dir.empty() ? "(none)" : p.localizer.cache_dir) << "\n"
+      << "  tracking: odom_alpha1..4: " << p.tracker.odom_alpha1 << ", " << p.tracker.odom_alpha2 << ", "
+      << p.tracker.odom_alpha3 << ", " << p.tracker.odom_alpha4
+      << ", min_consensus_fraction: " << p.tracker.min_consensus_fraction << ", min_support: " << p.tracker.min_support
+      << ", support_margin: " << p.tracker.support_margin << ", lost_updates: " << p.tracker.lost_updates
+      << ", max_hypotheses: " << p.tracker.max_hypotheses << ", global_interval: " << p.global_interval
+      << ", publish_initialpose: " << (p.publish_initialpose ? "true" : "false");
   return out.str();
 }
 
@@ -339,6 +401,7 @@ Params paramsFromTree(const core::ParamValue& tree, const std::string& ros_home,
   readMapParams(reader, &p);
   readNodeParams(reader, &p);
   readCoreParams(reader, &p);
+  readTrackingParams(reader, &p);
   p.localizer.cache_dir = defaultCacheDir(expandUser(ros_home, home), home);
   reader.read("cache_dir", &p.localizer.cache_dir);
   p.localizer.cache_dir = expandUser(p.localizer.cache_dir, home);

@@ -31,8 +31,14 @@ Eigen::Matrix3d carryForwardCovariance(const Eigen::Matrix3d& covariance, const 
   return jacobian * covariance * jacobian.transpose();
 }
 
-ResultPublisher::ResultPublisher(ros::NodeHandle& private_nh, const Params& params) : params_(params)
+ResultPublisher::ResultPublisher(ros::NodeHandle& nh, ros::NodeHandle& private_nh, const Params& params)
+  : params_(params)
 {
+  status_pub_ = private_nh.advertise<fdml_localization::Status>("status", 10, true);
+  if (params_.publish_initialpose)
+  {
+    initialpose_pub_ = nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("initialpose", 1, false);
+  }
   candidates_pub_ = private_nh.advertise<geometry_msgs::PoseArray>("candidates", 1, true);
   result_pub_ = private_nh.advertise<fdml_localization::LocalizationResult>("result", 1, true);
   pose_pub_ = private_nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("pose", 1, true);
@@ -62,16 +68,33 @@ void ResultPublisher::publishBatch(const Job& job, const core::Result& result, c
   const core::Candidate& best = result.candidates.front();
   reading_markers_pub_.publish(
       readingMarkers(job.readings, best.pose, best.inlier_mask, params_.global_frame_id, stamp));
-  if (!unambiguous)
+  if (unambiguous)
   {
-    return;
+    pose_pub_.publish(poseMessage(job, best, map));
   }
+}
+
+geometry_msgs::PoseWithCovarianceStamped ResultPublisher::poseMessage(const Job& job, const core::Candidate& best,
+                                                                      const core::MapRayCaster& map) const
+{
+  const Batch& batch = job.batch;
   geometry_msgs::PoseWithCovarianceStamped pose;
-  pose.header = candidates.header;
-  pose.pose.pose = candidates.poses.front();
+  pose.header.stamp = stampToTime(batch.newest_stamp);
+  pose.header.frame_id = params_.global_frame_id;
+  pose.pose.pose = toPoseMsg(carryForward(best.pose, batch.base_first, batch.base_newest));
   pose.pose.covariance = toCovariance6(
       carryForwardCovariance(usableCovariance(best, map), best.pose, batch.base_first, batch.base_newest));
-  pose_pub_.publish(pose);
+  return pose;
+}
+
+void ResultPublisher::publishStatus(const fdml_localization::Status& status)
+{
+  status_pub_.publish(status);
+}
+
+void ResultPublisher::publishInitialPose(const Job& job, const core::Candidate& best, const core::MapRayCaster& map)
+{
+  initialpose_pub_.publish(poseMessage(job, best, map));
 }
 
 Eigen::Matrix3d ResultPublisher::usableCovariance(const core::Candidate& best, const core::MapRayCaster& map) const

@@ -22,7 +22,9 @@ SolverWorker::SolverWorker(const Params& params, NodeState& state, ResultPublish
     {
       ROS_INFO("fdml_localizer: map converted from %s", map.summary.c_str());
     }
-    localizer_.reset(new core::Localizer(map.map, optionsFor(map)));
+    const core::LocalizerOptions options = optionsFor(map);
+    localizer_.reset(new core::Localizer(map.map, options));
+    tracker_ = trackerFor(map.map, options);
     publisher_.publishMapMarkers(*map_);
   }
 }
@@ -80,7 +82,7 @@ void SolverWorker::loop()
     outcome.message = noMapMessage();
     if (localizer_)
     {
-      outcome = solve(job);
+      outcome = job.from_sensors ? trackBatch(job) : solve(job);
     }
     for (const OutcomePromise& waiter : job.waiters)
     {
@@ -123,39 +125,23 @@ Outcome SolverWorker::solve(const Job& job)
 {
   Outcome outcome;
   core::Result result;
-  bool solved = false;
   try
   {
     result = localizer_->localize(job.readings);
-    solved = true;
+    outcome.success = !result.candidates.empty();
+    outcome.message = describeOutcome(result, core::isUnambiguous(result));
   }
   catch (const std::exception& error)
   {
     const bool invalid = dynamic_cast<const core::InvalidInput*>(&error) != nullptr;
     outcome.message = std::string(invalid ? "invalid readings: " : "the solver failed: ") + error.what();
   }
-  const bool unambiguous = solved && core::isUnambiguous(result);
   outcome.result = resultMessage(job, result);
-  if (solved)
   {
-    outcome.success = !result.candidates.empty();
-    outcome.message = describeOutcome(result, unambiguous);
+    std::lock_guard<std::mutex> lock(state_.mutex);
+    setDropCounts(state_.buffer.dropCounts(), &outcome.result);
   }
-  core::Pose2 map_to_odom;
-  const bool vouched = recordBatch(job, result, solved, unambiguous, &outcome, &map_to_odom);
-  if (job.from_sensors)
-  {
-    publisher_.publishBatch(job, result, outcome, unambiguous, *map_);
-  }
-  if (vouched && params_.publish_tf)
-  {
-    publisher_.publishMapToOdom(map_to_odom);
-  }
-  // Continuous mode solves many batches a second: its per-batch line is a debug message.
-  const bool quiet = job.from_sensors && solveMode(params_) == SolveMode::Continuous;
-  ROS_LOG(quiet ? ros::console::levels::Debug : ros::console::levels::Info, ROSCONSOLE_DEFAULT_NAME,
-          "fdml_localizer: %s: %s (%.3f s)", job.from_sensors ? "batch" : "~localize", outcome.message.c_str(),
-          result.times.total);
+  ROS_INFO("fdml_localizer: ~localize: %s (%.3f s)", outcome.message.c_str(), result.times.total);
   return outcome;
 }
 
@@ -193,40 +179,6 @@ std::string SolverWorker::describeOutcome(const core::Result& result, bool unamb
   return text;
 }
 
-bool SolverWorker::recordBatch(const Job& job, const core::Result& result, bool solved, bool unambiguous,
-                               Outcome* outcome, core::Pose2* map_to_odom)
-{
-  std::lock_guard<std::mutex> lock(state_.mutex);
-  setDropCounts(state_.buffer.dropCounts(), &outcome->result);
-  if (!job.from_sensors)
-  {
-    return false;
-  }
-  NodeStatistics& stats = state_.stats;
-  ++stats.batches_solved;
-  stats.last_solve_time = result.times.total;
-  stats.last_candidates = static_cast<int>(result.candidates.size());
-  stats.last_unambiguous = unambiguous;
-  if (!solved)
-  {
-    ++stats.solve_errors;
-    stats.last_error = outcome->message;
-  }
-  if (!state_.buffer.batchRequested())
-  {
-    state_.activity = solveMode(params_) == SolveMode::Continuous ? "tracking" : "idle";
-  }
-  // A batch formed before the latest relocalization request never brings map -> odom back.
-  if (!unambiguous || job.generation != state_.generation)
-  {
-    return false;
-  }
-  state_.have_map_to_odom = true;
-  state_.map_to_odom = core::compose(result.candidates[0].pose, core::inverse(job.batch.base_first));
-  *map_to_odom = state_.map_to_odom;
-  return true;
-}
-
 core::LocalizerOptions SolverWorker::optionsFor(const LoadedMap& map) const
 {
   if (!(map.grid_resolution > 0.0))
@@ -242,19 +194,31 @@ core::LocalizerOptions SolverWorker::optionsFor(const LoadedMap& map) const
   return toLocalizerOptions(effective);
 }
 
+std::unique_ptr<core::HypothesisTracker> SolverWorker::trackerFor(const std::shared_ptr<const core::MapRayCaster>& map,
+                                                                  const core::LocalizerOptions& options) const
+{
+  core::TrackerOptions tracker = params_.tracker;
+  tracker.agreement_tolerance = options.agreement_tolerance;
+  tracker.range_tolerance = options.range_tolerance;
+  return std::make_unique<core::HypothesisTracker>(map, tracker);
+}
+
 void SolverWorker::applyMap(const nav_msgs::OccupancyGrid::ConstPtr& msg)
 {
   const std::string source = "topic " + map_topic_;
   const auto start = std::chrono::steady_clock::now();
   std::shared_ptr<const core::MapRayCaster> map;
   std::unique_ptr<core::Localizer> localizer;
+  std::unique_ptr<core::HypothesisTracker> tracker;
   std::string error;
   try
   {
     const LoadedMap loaded = mapFromGrid(fromOccupancyGridMsg(*msg), toGridOptions(params_), source);
     ROS_INFO("fdml_localizer: map converted from %s: %s", source.c_str(), loaded.summary.c_str());
-    localizer.reset(new core::Localizer(loaded.map, optionsFor(loaded)));
+    const core::LocalizerOptions options = optionsFor(loaded);
+    localizer.reset(new core::Localizer(loaded.map, options));
     localizer->prepare();
+    tracker = trackerFor(loaded.map, options);
     map = loaded.map;
   }
   catch (const std::exception& exception)
@@ -276,6 +240,12 @@ void SolverWorker::applyMap(const nav_msgs::OccupancyGrid::ConstPtr& msg)
   // Between two solves: the next one uses the new map.
   map_ = map;
   localizer_ = std::move(localizer);
+  if (tracker_)
+  {
+    // A map of the same frame (a SLAM map growing): the hypotheses carry over.
+    tracker->restore(tracker_->hypotheses());
+  }
+  tracker_ = std::move(tracker);
   ROS_INFO("fdml_localizer: new map in use (%s engine, conversion and tables in %.2f s)", params_.engine.c_str(),
            core::secondsSince(start));
   ++state_.stats.maps_accepted;

@@ -20,16 +20,12 @@
  * solve. A grid that cannot be converted is logged and counted and the previous map stays in
  * use. Until there is a map, ~relocalize and ~localize fail with "no map yet".
  *
- * Relocalization (~relocalize, global_localization) clears the buffer and waits for k fresh
- * readings, each taken at its own stamp: the readings must differ, so the robot must rotate
- * in place (or drive) or the sensors must sweep while it waits. The readings' relative poses
- * come from odometry and the sensors' mounting on tf. map -> odom is not published from the
- * request until the next unambiguous answer.
- *
- * ~pose and map -> odom are published only when the best candidate is unambiguous: there is
- * exactly one candidate, or the best's net consensus is strictly larger than the second's
- * (core::isUnambiguous(), the one rule in the core). Candidates tied on net consensus are
- * different places that explain the readings equally well (a symmetric room): no pose is claimed.
+ * Tracking (docs/localizer_node.md#tracking): the worker updates a core::HypothesisTracker with
+ * every batch; global searches seed it at start (continuous mode), on ~relocalize,
+ * global_localization and initialpose hints, on a detected kidnap (continuous mode) and after
+ * ~global_interval updates without a clearly supported hypothesis. ~relocalize answers once one
+ * hypothesis is clearly supported. ~pose and map -> odom follow every update while one is, and
+ * are withdrawn otherwise; ~status reports the state.
  */
 #pragma once
 
@@ -44,6 +40,7 @@
 #include <fdml_localization/Relocalize.h>
 
 #include <diagnostic_updater/diagnostic_updater.h>
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
@@ -84,7 +81,10 @@ private:
   /// The message of a service refused before the worker can answer; empty when it can.
   std::string refusalLocked() const;
   void mapCallback(const nav_msgs::OccupancyGrid::ConstPtr& msg);
+  /// Stores a user's pose hint for the worker (ignores this node's own hand-over).
+  void initialPoseCallback(const ros::MessageEvent<const geometry_msgs::PoseWithCovarianceStamped>& event);
   void processTimer(const ros::WallTimerEvent& event);
+  void statusTimer(const ros::WallTimerEvent& event);
   void tfTimer(const ros::WallTimerEvent& event);
 
   Params params_;
@@ -102,11 +102,13 @@ private:
   ResultPublisher publisher_;
   SensorInput input_;
   ros::Subscriber map_sub_;  ///< with ~use_map_topic only
+  ros::Subscriber initialpose_sub_;
   std::unique_ptr<SolverWorker> worker_;
   ros::ServiceServer relocalize_srv_;
   ros::ServiceServer localize_srv_;
   ros::ServiceServer global_localization_srv_;
   ros::WallTimer process_timer_;
+  ros::WallTimer status_timer_;
   ros::WallTimer tf_timer_;
 };
 

@@ -1,8 +1,8 @@
 /**
  * @file node_state.h
  * @brief What the localizer node's threads share: the one mutex, what it guards (the reading
- *        buffer, the job queue, the service waiters and the counters), and the jobs the worker
- *        solves.
+ *        buffer, the job queue, the service waiters, the relocalization request, the pose hint,
+ *        the tracking status and the counters), and the jobs the worker solves.
  */
 #pragma once
 
@@ -10,6 +10,9 @@
 #include "fdml_localization/ros/reading_buffer.h"
 
 #include <fdml_localization/LocalizationResult.h>
+#include <fdml_localization/Status.h>
+
+#include <Eigen/Core>
 
 #include <nav_msgs/OccupancyGrid.h>
 
@@ -19,6 +22,7 @@
 #include <future>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -60,6 +64,26 @@ struct NodeStatistics
   std::string last_map_error;
 };
 
+/// A user's pose hint (initialpose), applied by the worker to the next batch.
+struct PoseHint
+{
+  core::Pose2 pose;                                      ///< the base in the map [m, rad]
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< of (x, y, yaw)
+};
+
+/// The tracking status the worker reports (~status and diagnostics).
+struct TrackingStatus
+{
+  std::uint8_t state = fdml_localization::Status::LOST;
+  std::string message = "no hypothesis yet";
+  int hypotheses = 0;
+  double best_support = 0.0;
+  double second_support = 0.0;
+  std::uint64_t received_at_update = 0;  ///< ReadingBuffer::received() at the last update
+  std::uint64_t kidnaps_detected = 0;
+  std::uint64_t global_searches = 0;
+};
+
 /**
  * @brief The state the node's threads share. `mutex` guards every field: the sensor callbacks
  *        and the processing timer (SensorInput), the services (LocalizerNode), the worker
@@ -76,7 +100,7 @@ struct NodeState
   ReadingBuffer buffer;                            ///< readings waiting for tf and for a batch
   std::unique_ptr<Job> queued_batch;               ///< newest sensor batch not yet taken by the worker
   std::deque<Job> queued_requests;                 ///< ~localize requests, FIFO
-  std::vector<OutcomePromise> relocalize_waiters;  ///< for the next sensor batch
+  std::vector<OutcomePromise> relocalize_waiters;  ///< answered once a hypothesis is clearly supported
   bool shutting_down = false;
   std::uint64_t generation = 0;  ///< bumped by every relocalization request
   bool have_map_to_odom = false;
@@ -86,9 +110,17 @@ struct NodeState
   std::string map_source;                         ///< where the map in use came from
   std::string activity = "starting";              ///< human-readable worker state
   NodeStatistics stats;
+  /// A relocalization is under way (~relocalize, global_localization, start-up in continuous
+  /// mode, a kidnap): global searches seed hypotheses until one is clearly supported.
+  bool relocalizing = false;
+  std::optional<PoseHint> pending_hint;  ///< the newest initialpose not yet applied
+  TrackingStatus tracking;
 
-  /// Queues a sensor batch for the worker; a newer batch replaces a queued one and inherits its
-  /// waiters (caller holds mutex).
+  /// The ~status message now (caller holds mutex).
+  fdml_localization::Status statusLocked() const;
+
+  /// Queues a sensor batch for the worker; a newer batch replaces a queued one (caller holds
+  /// mutex).
   void queueBatchLocked(std::unique_ptr<Job> job);
   /// Answers every waiting service call with @p message (caller holds mutex).
   void failAllWaitersLocked(const std::string& message);

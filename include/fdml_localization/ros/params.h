@@ -8,6 +8,7 @@
 #include "fdml_localization/core/map/grid/grid_to_polygon.h"
 #include "fdml_localization/core/localization/localizer.h"
 #include "fdml_localization/core/util/param_tree.h"
+#include "fdml_localization/core/tracking/hypothesis_tracker.h"
 
 #include <string>
 #include <vector>
@@ -82,7 +83,18 @@ struct Params
 
   /// Parameters set with the wrong type (ParamReader messages; validate() reports them first).
   std::vector<std::string> type_errors;
+  // Tracking (docs/localizer_node.md#tracking): ~odom_alpha1..4, ~min_consensus_fraction,
+  // ~support_decay, ~min_support, ~support_margin, ~tolerated_misses, ~max_misses,
+  // ~lost_updates, ~max_hypotheses and the ~tracking_* box options map onto core::TrackerOptions,
+  // validated by core::validate() (its tolerances are the localizer's).
+  core::TrackerOptions tracker;
+  int global_interval = 40;  ///< ~global_interval: updates without a clear hypothesis between global searches, [1, 1e6]
+  bool publish_initialpose =
+      false;  ///< ~publish_initialpose: the first clear fix after a relocalization on initialpose
 };
+
+/// Largest ~relocalize timeout [s] (a larger or non-finite request is refused).
+constexpr double kMaxRelocalizeTimeout = 3600.0;
 
 /**
  * @brief Every problem with @p params, each naming the parameter (with its "~") and its allowed

@@ -1,7 +1,7 @@
 /**
  * @file result_publisher.h
- * @brief The localizer node's outputs: ~result, ~candidates, ~pose, the reading and map
- *        markers, and map -> odom on tf.
+ * @brief The localizer node's outputs: ~result, ~candidates, ~pose, ~status, the reading and
+ *        map markers, map -> odom on tf, and (~publish_initialpose) the hand-over on initialpose.
  */
 #pragma once
 
@@ -9,6 +9,7 @@
 #include "fdml_localization/ros/node_state.h"
 #include "fdml_localization/ros/params.h"
 
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <ros/ros.h>
 #include <tf2_ros/transform_broadcaster.h>
 
@@ -29,7 +30,8 @@ Eigen::Matrix3d carryForwardCovariance(const Eigen::Matrix3d& covariance, const 
 class ResultPublisher
 {
 public:
-  ResultPublisher(ros::NodeHandle& private_nh, const Params& params);
+  /// @param nh the node's namespace (initialpose); @p private_nh the outputs' namespace
+  ResultPublisher(ros::NodeHandle& nh, ros::NodeHandle& private_nh, const Params& params);
 
   /**
    * @brief Publishes a solved sensor batch: ~result, ~candidates and the reading markers always;
@@ -42,10 +44,20 @@ public:
   /// Broadcasts map -> odom, future-dated by ~transform_tolerance like AMCL.
   void publishMapToOdom(const core::Pose2& map_to_odom);
 
+  /// Publishes ~status.
+  void publishStatus(const fdml_localization::Status& status);
+
+  /// Hands a clearly supported fix over to a downstream AMCL: @p best (the base at the batch's
+  /// first reading) carried forward to the newest reading, on initialpose.
+  void publishInitialPose(const Job& job, const core::Candidate& best, const core::MapRayCaster& map);
+
   /// Publishes the map's walls (latched).
   void publishMapMarkers(const core::MapRayCaster& map);
 
 private:
+  /// The ~pose message of @p best (carried forward to the batch's newest reading).
+  geometry_msgs::PoseWithCovarianceStamped poseMessage(const Job& job, const core::Candidate& best,
+                                                       const core::MapRayCaster& map) const;
   /// The best candidate's covariance, or one grid cell in each direction when the polish gave
   /// none.
   Eigen::Matrix3d usableCovariance(const core::Candidate& best, const core::MapRayCaster& map) const;
@@ -54,6 +66,8 @@ private:
   ros::Publisher candidates_pub_;
   ros::Publisher result_pub_;
   ros::Publisher pose_pub_;
+  ros::Publisher status_pub_;
+  ros::Publisher initialpose_pub_;  ///< with ~publish_initialpose only
   ros::Publisher map_markers_pub_;
   ros::Publisher reading_markers_pub_;
   tf2_ros::TransformBroadcaster tf_broadcaster_;

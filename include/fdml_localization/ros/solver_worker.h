@@ -1,12 +1,15 @@
 /**
  * @file solver_worker.h
- * @brief The localizer node's worker thread: owns the core::Localizer, takes jobs (~localize
- *        requests first, then the newest sensor batch) and new maps from the shared state,
- *        solves, and hands the outcome to the publisher and the waiting service calls.
+ * @brief The localizer node's worker thread: owns the core::Localizer and the
+ *        core::HypothesisTracker, takes jobs (~localize requests first, then the newest sensor
+ *        batch) and new maps from the shared state. A sensor batch updates the tracker (a global
+ *        search seeds it when needed, see docs/localizer_node.md#tracking); the outcome goes to
+ *        the publisher and the waiting service calls.
  */
 #pragma once
 
 #include "fdml_localization/core/localization/localizer.h"
+#include "fdml_localization/core/tracking/hypothesis_tracker.h"
 #include "fdml_localization/ros/map_loading.h"
 #include "fdml_localization/ros/node_state.h"
 #include "fdml_localization/ros/params.h"
@@ -15,8 +18,10 @@
 #include <nav_msgs/OccupancyGrid.h>
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 namespace fdml_localization
 {
@@ -43,28 +48,65 @@ private:
   void loop();
   /// Takes the next map or job from the shared state; false on shutdown.
   bool takeWork(Job* job, nav_msgs::OccupancyGrid::ConstPtr* map);
+  /// A ~localize request: one global solve of its readings.
   Outcome solve(const Job& job);
   /// ~result for @p result: in the map frame; for a sensor batch stamped at its newest reading,
   /// with the poses carried forward to it by odometry.
   fdml_localization::LocalizationResult resultMessage(const Job& job, const core::Result& result) const;
   /// The human-readable outcome of a solve.
   static std::string describeOutcome(const core::Result& result, bool unambiguous);
-  /// Adds the drop counts to @p outcome and records a solved sensor batch in the shared state.
-  /// @return true when the batch vouches for a new map -> odom (set in @p map_to_odom)
-  bool recordBatch(const Job& job, const core::Result& result, bool solved, bool unambiguous, Outcome* outcome,
-                   core::Pose2* map_to_odom);
   /// The core options for @p map: the parameters, with grid tolerances for a converted grid.
   core::LocalizerOptions optionsFor(const LoadedMap& map) const;
+  /// The tracker for @p map, with the localizer's tolerances.
+  std::unique_ptr<core::HypothesisTracker> trackerFor(const std::shared_ptr<const core::MapRayCaster>& map,
+                                                      const core::LocalizerOptions& options) const;
   /// Converts @p msg, builds and prepares its localizer and swaps both in; on failure logs and
   /// counts the reason and keeps the previous map.
   void applyMap(const nav_msgs::OccupancyGrid::ConstPtr& msg);
+
+  // Tracking of sensor batches (solver_worker_tracking.cpp).
+  /// What the shared state asks of the next sensor batch.
+  struct Directive
+  {
+    bool stale = false;         ///< formed before the latest relocalization request
+    bool restart = false;       ///< a relocalization request since the last batch: drop hypotheses
+    bool relocalizing = false;  ///< a relocalization is under way
+    std::optional<PoseHint> hint;
+  };
+  Directive takeDirective(const Job& job);
+  /// A sensor batch: a hint, a global search or a tracking update, then publishing.
+  Outcome trackBatch(const Job& job);
+  /// A hint, a global search or a tracking update on @p job; the event to report (empty: none).
+  std::string stepTracker(const Directive& directive, const Job& job);
+  /// The event of a track lost since the last batch (sets @p kidnap), or empty.
+  std::string lostTrackEvent(core::TrackState track, bool* kidnap);
+  /// ~result, ~candidates, markers; ~pose, map -> odom and the hand-over while clearly supported.
+  void publishTracking(const Job& job, const core::Result& result, const Outcome& outcome);
+  /// True when this batch needs a global search (docs/localizer_node.md#tracking).
+  bool needsGlobalSearch(bool relocalizing) const;
+  /// Runs the global search on @p job and seeds the tracker with its candidates.
+  std::string globalSearch(const Job& job);
+  /// Applies a pose hint to the tracker; the outcome as text.
+  std::string applyHint(const PoseHint& hint, const Job& job);
+  /// The hypotheses as a core::Result (poses at the batch's first reading), best first.
+  core::Result trackedResult(const Job& job) const;
+  /// Records the outcome in the shared state (status, map -> odom, waiters to answer).
+  /// @return the relocalization waiters to answer (when one hypothesis became clearly supported)
+  std::vector<OutcomePromise> recordTracking(const Job& job, const std::string& event, bool kidnap, std::uint8_t state,
+                                             Outcome* outcome);
 
   const Params& params_;
   NodeState& state_;
   ResultPublisher& publisher_;
   std::string map_topic_;
-  std::shared_ptr<const core::MapRayCaster> map_;  ///< worker thread only; null until a map
-  std::unique_ptr<core::Localizer> localizer_;     ///< worker thread only; null until a map
+  std::shared_ptr<const core::MapRayCaster> map_;     ///< worker thread only; null until a map
+  std::unique_ptr<core::Localizer> localizer_;        ///< worker thread only; null until a map
+  std::unique_ptr<core::HypothesisTracker> tracker_;  ///< worker thread only; null until a map
+  std::uint64_t generation_ = 0;                      ///< NodeState::generation of the last batch
+  int updates_since_global_ = 0;                      ///< tracking updates since the last global search
+  bool handover_pending_ = false;                     ///< ~publish_initialpose: a relocalization awaits its fix
+  bool published_empty_ = false;                      ///< the last ~result published had no hypothesis
+  bool was_tracking_ = false;                         ///< the last batch had a clearly supported hypothesis
   std::thread thread_;
 };
 

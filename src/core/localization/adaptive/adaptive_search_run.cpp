@@ -46,12 +46,15 @@ AdaptiveSearch::AdaptiveSearch(const MapRayCaster& map, const BoxOccupancy& occu
   : map_(map), occupancy_(occupancy), readings_(std::move(readings)), options_(options), start_(Clock::now())
 {
   const Box2& bounds = map_.map().bounds();
+  root_ =
+      options_.region.value_or(PoseBox{ bounds.min.x(), bounds.max.x(), bounds.min.y(), bounds.max.y(), -kPi, kPi });
+  root_.t1 = std::min(root_.t1, root_.t0 + kTwoPi);
   // Cell counts; a ratio within rounding of an integer (cell = size / n) gives exactly n cells.
   auto cells = [](double ratio) { return std::max<std::int64_t>(1, std::ceil(ratio * (1.0 - 1e-12))); };
-  nx_ = cells(bounds.size().x() / options_.cell_xy);
-  ny_ = cells(bounds.size().y() / options_.cell_xy);
-  nt_ = cells(kTwoPi / options_.cell_theta);
-  cell_t_ = kTwoPi / static_cast<double>(nt_);
+  nx_ = cells((root_.x1 - root_.x0) / options_.cell_xy);
+  ny_ = cells((root_.y1 - root_.y0) / options_.cell_xy);
+  nt_ = cells((root_.t1 - root_.t0) / options_.cell_theta);
+  cell_t_ = (root_.t1 - root_.t0) / static_cast<double>(nt_);
   lx_ = levelsFor(nx_);
   ly_ = levelsFor(ny_);
   lt_ = levelsFor(nt_);
@@ -67,15 +70,14 @@ AdaptiveSearch::AdaptiveSearch(const MapRayCaster& map, const BoxOccupancy& occu
 
 PoseBox AdaptiveSearch::boxOf(const Node& n, int level) const
 {
-  const Box2& bounds = map_.map().bounds();
   auto span = [&](int axis_levels) { return std::int64_t{ 1 } << std::max(axis_levels - level, 0); };
   PoseBox b;
-  b.x0 = bounds.min.x() + n.ix * options_.cell_xy;
-  b.x1 = std::min(bounds.max.x(), b.x0 + span(lx_) * options_.cell_xy);
-  b.y0 = bounds.min.y() + n.iy * options_.cell_xy;
-  b.y1 = std::min(bounds.max.y(), b.y0 + span(ly_) * options_.cell_xy);
-  b.t0 = -kPi + n.it * cell_t_;
-  b.t1 = std::min(kPi, b.t0 + span(lt_) * cell_t_);
+  b.x0 = root_.x0 + n.ix * options_.cell_xy;
+  b.x1 = std::min(root_.x1, b.x0 + span(lx_) * options_.cell_xy);
+  b.y0 = root_.y0 + n.iy * options_.cell_xy;
+  b.y1 = std::min(root_.y1, b.y0 + span(ly_) * options_.cell_xy);
+  b.t0 = root_.t0 + n.it * cell_t_;
+  b.t1 = std::min(root_.t1, b.t0 + span(lt_) * cell_t_);
   return b;
 }
 
@@ -91,8 +93,8 @@ void AdaptiveSearch::prepareArcs(int level)
   arcs_[level].resize(static_cast<std::size_t>(nodes) * k * 2);
   for (std::int64_t t = 0; t < nodes; ++t)
   {
-    const double t0 = -kPi + t * span * cell_t_;
-    const double t1 = std::min(kPi, t0 + span * cell_t_);
+    const double t0 = root_.t0 + t * span * cell_t_;
+    const double t1 = std::min(root_.t1, t0 + span * cell_t_);
     for (std::size_t r = 0; r < k; ++r)
     {
       const Reading& reading = readings_[r];

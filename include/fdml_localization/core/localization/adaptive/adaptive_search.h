@@ -16,6 +16,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 namespace fdml_localization
@@ -59,6 +60,9 @@ struct AdaptiveSearchOptions
   int floor_count = 0;
   /// Levels with at most this many boxes are tested on one thread (no barrier cost).
   long parallel_threshold = 2000;
+  /// The pose box the root grid covers (a local search, e.g. around a tracked pose); unset =
+  /// the map's bounding box x [-pi, pi). Its theta span is clamped to 2 pi.
+  std::optional<PoseBox> region;
 };
 
 /// The outcome of a box search.
@@ -122,6 +126,7 @@ private:
   const BoxOccupancy& occupancy_;
   std::vector<Reading> readings_;
   AdaptiveSearchOptions options_;
+  PoseBox root_;  ///< the box the root grid covers (options.region or the whole map)
   std::int64_t nx_ = 1, ny_ = 1, nt_ = 1;
   double cell_t_ = 1.0;
   int lx_ = 0, ly_ = 0, lt_ = 0, levels_ = 0;

@@ -1,0 +1,189 @@
+/**
+ * @file hypothesis_tracker.h
+ * @brief Pose hypotheses across time (ROS-free): each hypothesis is a map -> odom transform, so
+ *        odometry carries it between readings; its uncertainty box grows with the distance and
+ *        the rotation travelled since its last fix (AMCL-like odom_alpha1..4). Every update
+ *        re-solves each hypothesis locally over the last k readings (local_solve.h: a
+ *        conservative box search around its prediction, then the shared refinement); support is
+ *        a decayed sum of net consensus, so places that explain one batch equally are told apart
+ *        as the robot moves, and one spoiled batch neither moves nor drops a well-supported
+ *        hypothesis.
+ *
+ * Poses: the readings of an update are relative to the base at the odometry pose `reference`
+ * (the node's batches: the base at the first reading); a hypothesis's pose of the base at any
+ * odometry pose o is map_to_odom (+) o.
+ */
+#pragma once
+
+#include "fdml_localization/core/localization/adaptive/adaptive_search.h"
+#include "fdml_localization/core/localization/localizer.h"
+#include "fdml_localization/core/localization/voxel/box_occupancy.h"
+#include "fdml_localization/core/tracking/local_solve.h"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace fdml_localization
+{
+namespace core
+{
+/// Options of the tracker. validate() lists every out-of-range value.
+struct TrackerOptions
+{
+  /// Net consensus a pose needs to count as a fix, as a fraction of k (k' = ceil(fraction k),
+  /// at least 3), in (0, 1].
+  double min_consensus_fraction = 0.6;
+  // Growth of the uncertainty box with odometry, as AMCL's odom_alpha1..4 (>= 0): the box's
+  // half-widths are box_min + 3 sigma, sigma_theta = alpha1 |rot| + alpha2 |trans|,
+  // sigma_xy = alpha3 |trans| + alpha4 |rot|, summed over the motion since the last fix.
+  double odom_alpha1 = 0.2;     ///< rotation noise from rotation [rad/rad]
+  double odom_alpha2 = 0.2;     ///< rotation noise from translation [rad/m]
+  double odom_alpha3 = 0.2;     ///< translation noise from translation [m/m]
+  double odom_alpha4 = 0.2;     ///< translation noise from rotation [m/rad]
+  double box_min_xy = 0.1;      ///< half-width of the box right after a fix [m], (0, box_max_xy]
+  double box_min_theta = 0.05;  ///< ... in theta [rad], (0, box_max_theta]
+  double box_max_xy = 1.0;      ///< the box stops growing here [m]
+  double box_max_theta = 0.6;   ///< ... in theta [rad], <= pi
+  double cell_xy = 0.05;        ///< leaf size of the local box search [m], (0, box_min_xy]
+  double cell_theta = 0.025;    ///< ... in theta [rad], (0, box_min_theta]
+  /// support <- decay support + net consensus / k per update; a miss adds the best consensus
+  /// (below k') refined in its box, 0 for an empty box. In (0, 1).
+  double support_decay = 0.95;
+  double min_support = 3.0;           ///< a clearly supported hypothesis has at least this support, > 0
+  double support_margin = 1.5;        ///< ... and this much more than any other, >= 0
+  int tolerated_misses = 1;           ///< ... and missed at most this many updates in a row, >= 0
+  int max_misses = 10;                ///< a hypothesis missing this many updates in a row is dropped, >= 1
+  int lost_updates = 6;               ///< every hypothesis missed this many updates in a row: lost, >= 1
+  int max_hypotheses = 10;            ///< the least supported beyond this are dropped, >= 1
+  double merge_distance = 0.1;        ///< hypotheses closer than this [m] ...
+  double merge_angle = 0.1;           ///< ... and this [rad] are merged (the better kept)
+  double agreement_tolerance = 0.05;  ///< eps [m] (the node takes the localizer's)
+  double range_tolerance = 0.02;      ///< tau [m] (the node takes the localizer's)
+  int max_seeds = 3;                  ///< leaves refined per local solve
+};
+
+/// Every problem of @p options, as "NAME = VALUE is out of range; allowed: RANGE" (@p name maps
+/// an option's name to the caller's; empty = the option's own name).
+std::vector<std::string> validate(const TrackerOptions& options,
+                                  const std::function<std::string(const std::string&)>& name = {});
+
+/// One pose hypothesis.
+struct Hypothesis
+{
+  std::uint64_t id = 0;    ///< unique in the tracker's life
+  Pose2 map_to_odom;       ///< the hypothesis [m, rad]
+  double travelled = 0.0;  ///< odometry distance since the last fix [m]
+  double turned = 0.0;     ///< odometry rotation since the last fix [rad]
+  double support = 0.0;    ///< decayed sum of net consensus / k
+  int misses = 0;          ///< updates in a row without a fix
+  int fixes = 0;           ///< updates with a fix
+  Candidate last_fix;      ///< the last fix (pose of the base at its update's reference)
+};
+
+/// The tracker's state.
+enum class TrackState
+{
+  Empty,      ///< no hypothesis
+  Tracking,   ///< exactly one hypothesis is clearly supported
+  Ambiguous,  ///< hypotheses, none clearly supported
+  Lost        ///< every hypothesis missed lost_updates updates in a row
+};
+const char* toString(TrackState state);
+
+/// What one update did.
+struct UpdateReport
+{
+  int fixed = 0;           ///< hypotheses with a fix
+  int missed = 0;          ///< hypotheses without one
+  int dropped = 0;         ///< hypotheses dropped (missed max_misses times, merged, beyond the bound)
+  int min_consensus = 0;   ///< the k' used
+  int best_possible = 0;   ///< the largest consensus any box may hold (over every hypothesis)
+  bool truncated = false;  ///< a box search hit its budget
+};
+
+/// What a hint (initialpose) gave.
+struct HintOutcome
+{
+  bool accepted = false;   ///< at least one pose in the hint's box explains k' readings
+  int best_consensus = 0;  ///< the best net consensus found in the box (-k: nothing refined)
+  int min_consensus = 0;   ///< the k' required
+  int hypotheses = 0;      ///< hypotheses seeded
+};
+
+/// See the file comment. Not thread-safe.
+class HypothesisTracker
+{
+public:
+  /// @throws std::invalid_argument listing every problem of @p options, or for a null map
+  HypothesisTracker(std::shared_ptr<const MapRayCaster> map, const TrackerOptions& options);
+
+  /**
+   * @brief Adds a hypothesis per candidate (a global solve's), each with @p support, merged
+   *        with any existing one it duplicates (which keeps the larger support).
+   * @param reference the odometry pose of the base the candidates' poses refer to
+   */
+  void seed(const std::vector<Candidate>& candidates, const Pose2& reference, double support);
+
+  /**
+   * @brief A user's hint: the poses in @p box (around the base at @p reference) that explain
+   *        k' of @p readings replace every hypothesis, each with support min_support; when none
+   *        does, the hypotheses are kept and the outcome says the best consensus found.
+   */
+  HintOutcome seedFromHint(const PoseBox& box, const std::vector<Reading>& readings, const Pose2& reference);
+
+  /// Re-solves every hypothesis over @p readings (relative to the base at odometry pose
+  /// @p reference) in its box around its prediction; updates support, merges, bounds.
+  UpdateReport update(const std::vector<Reading>& readings, const Pose2& reference);
+
+  /// Drops every hypothesis (a relocalization).
+  void clear();
+  /// Replaces the hypotheses (carried over to a tracker of a new map of the same frame).
+  void restore(std::vector<Hypothesis> hypotheses);
+
+  /// The hypotheses, best (most supported) first.
+  const std::vector<Hypothesis>& hypotheses() const
+  {
+    return hypotheses_;
+  }
+  /// The clearly supported hypothesis (see TrackerOptions: min_support, support_margin,
+  /// tolerated_misses), or null.
+  const Hypothesis* clearlySupported() const;
+  TrackState state() const;
+  /// Updates in a row in which no hypothesis had a fix (0 after a fix).
+  int failedUpdates() const
+  {
+    return failed_updates_;
+  }
+  /// The k' for @p k readings.
+  int minConsensus(int k) const;
+  /// The uncertainty box of @p hypothesis around its pose of the base at @p reference.
+  PoseBox boxOf(const Hypothesis& hypothesis, const Pose2& reference) const;
+  const TrackerOptions& options() const
+  {
+    return options_;
+  }
+
+private:
+  LocalSolveSettings solveSettings(int k) const;
+  /// Adds the odometry motion from the last reference to @p reference to every hypothesis.
+  void accumulateMotion(const Pose2& reference);
+  /// Merges duplicates, drops hypotheses that missed too often, sorts, bounds the count.
+  int prune();
+
+  std::shared_ptr<const MapRayCaster> map_;
+  TrackerOptions options_;
+  BoxOccupancy occupancy_;
+  std::vector<Hypothesis> hypotheses_;
+  bool have_reference_ = false;
+  Pose2 last_reference_;
+  int failed_updates_ = 0;
+  std::uint64_t next_id_ = 1;
+};
+
+}  // namespace core
+}  // namespace fdml_localization

@@ -1,0 +1,63 @@
+/**
+ * @file local_solve.h
+ * @brief The robust solve restricted to a box of poses: the adaptive engine's conservative
+ *        branch and prune over the box (no pose of the box that may explain k' readings is
+ *        pruned), then the shared refinement (robust_search.h: refineSeed) from the best leaves.
+ *        The tracker (hypothesis_tracker.h) runs it around each hypothesis's prediction.
+ */
+#pragma once
+
+#include "fdml_localization/core/localization/adaptive/adaptive_search.h"
+#include "fdml_localization/core/localization/localizer.h"
+#include "fdml_localization/core/localization/voxel/box_occupancy.h"
+
+#include <vector>
+
+namespace fdml_localization
+{
+namespace core
+{
+/// Settings of localSolve().
+struct LocalSolveSettings
+{
+  int min_consensus = 6;              ///< k': net consensus a pose needs to count as a fix
+  double cell_xy = 0.05;              ///< leaf size of the box search in x, y [m]
+  double cell_theta = 0.025;          ///< ... and in theta [rad]
+  double agreement_tolerance = 0.05;  ///< eps [m]
+  double range_tolerance = 0.02;      ///< tau [m] (the box test's noise band)
+  int max_seeds = 3;                  ///< distinct leaves refined (besides the box's centre)
+  long max_boxes = 200000;            ///< box budget of the search
+};
+
+/// The outcome of localSolve().
+struct LocalSolveOutcome
+{
+  /// Refined poses inside the box (inflated by one leaf) with net consensus >= k', best first
+  /// (ranking.h), duplicates (within 2 leaves) removed. Empty: the box holds no fix.
+  std::vector<Candidate> fixes;
+  /// The largest number of readings any leaf of the box may explain (0 when the search pruned
+  /// every box at k'): an upper bound of the consensus inside the box when the search was not
+  /// truncated.
+  int best_possible = 0;
+  /// The best net consensus reached by a refined pose in the box (-k when nothing was refined).
+  int best_consensus = 0;
+  bool truncated = false;  ///< the box budget ran out
+};
+
+/**
+ * @brief Finds the poses in @p box that explain at least settings.min_consensus readings (net of
+ *        contradicted ones): a box search at that k' (AdaptiveSearchOptions::region), then
+ *        refineSeed from the box's centre and from up to max_seeds distinct leaves of the highest
+ *        counts. A refined pose that left the box (by more than one leaf) is not a fix.
+ * @param occupancy the map's occupancy at a cell of at most settings.cell_xy
+ */
+LocalSolveOutcome localSolve(const MapRayCaster& map, const BoxOccupancy& occupancy,
+                             const std::vector<Reading>& readings, const PoseBox& box,
+                             const LocalSolveSettings& settings);
+
+/// True when @p pose lies in @p box inflated by @p margin_xy [m] and @p margin_theta [rad]
+/// (theta compared modulo 2 pi).
+bool insideBox(const Pose2& pose, const PoseBox& box, double margin_xy, double margin_theta);
+
+}  // namespace core
+}  // namespace fdml_localization

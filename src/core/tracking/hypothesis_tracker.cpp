@@ -1,0 +1,295 @@
+#include "fdml_localization/core/tracking/hypothesis_tracker.h"
+
+#include "fdml_localization/core/localization/ranking.h"
+
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+namespace fdml_localization
+{
+namespace core
+{
+namespace
+{
+bool samePlace(const Pose2& a, const Pose2& b, double distance, double angle)
+{
+  return (a.position() - b.position()).norm() <= distance && std::abs(angleDiff(a.theta, b.theta)) <= angle;
+}
+
+/**
+ * The fix fused with the prediction (one Kalman step): the prediction's covariance is the box's
+ * (half-widths as 3 sigma), the fix's the polish's. A direction the readings leave loose (a
+ * corridor's axis) keeps the prediction; a spoiled batch moves the pose less than its fix.
+ */
+Pose2 fuse(const Pose2& predicted, const PoseBox& box, const Candidate& fix)
+{
+  const Eigen::Vector3d box_sigma(0.5 * (box.x1 - box.x0) / 3.0, 0.5 * (box.y1 - box.y0) / 3.0,
+                                  0.5 * (box.t1 - box.t0) / 3.0);
+  const Eigen::Matrix3d prior = box_sigma.cwiseProduct(box_sigma).asDiagonal();
+  const Eigen::Matrix3d& measured = fix.covariance;
+  if (!measured.allFinite() || measured.diagonal().minCoeff() <= 0.0)
+  {
+    return fix.pose;
+  }
+  const Eigen::Matrix3d sum = prior + measured;
+  if (std::abs(sum.determinant()) < 1e-30)
+  {
+    return fix.pose;
+  }
+  const Eigen::Vector3d innovation(fix.pose.x - predicted.x, fix.pose.y - predicted.y,
+                                   angleDiff(fix.pose.theta, predicted.theta));
+  const Eigen::Vector3d step = prior * sum.inverse() * innovation;
+  return Pose2(predicted.x + step.x(), predicted.y + step.y(), wrapAngle(predicted.theta + step.z()));
+}
+
+std::string joined(const std::vector<std::string>& errors)
+{
+  std::string text;
+  for (const std::string& error : errors)
+  {
+    text += (text.empty() ? "" : "; ") + error;
+  }
+  return text;
+}
+}  // namespace
+
+HypothesisTracker::HypothesisTracker(std::shared_ptr<const MapRayCaster> map, const TrackerOptions& options)
+  : map_(std::move(map)), options_(options)
+{
+  const std::vector<std::string> errors = validate(options_);
+  if (!errors.empty())
+  {
+    throw std::invalid_argument("tracker options: " + joined(errors));
+  }
+  if (!map_)
+  {
+    throw std::invalid_argument("tracker: no map");
+  }
+  occupancy_ = BoxOccupancy(*map_, options_.cell_xy);
+}
+
+int HypothesisTracker::minConsensus(int k) const
+{
+  const int wanted = static_cast<int>(std::ceil(options_.min_consensus_fraction * k - 1e-9));
+  return std::min(k, std::max(3, wanted));
+}
+
+LocalSolveSettings HypothesisTracker::solveSettings(int k) const
+{
+  LocalSolveSettings s;
+  s.min_consensus = minConsensus(k);
+  s.cell_xy = options_.cell_xy;
+  s.cell_theta = options_.cell_theta;
+  s.agreement_tolerance = options_.agreement_tolerance;
+  s.range_tolerance = options_.range_tolerance;
+  s.max_seeds = options_.max_seeds;
+  return s;
+}
+
+PoseBox HypothesisTracker::boxOf(const Hypothesis& h, const Pose2& reference) const
+{
+  const Pose2 p = compose(h.map_to_odom, reference);
+  const TrackerOptions& o = options_;
+  const double xy =
+      std::min(o.box_max_xy, o.box_min_xy + 3.0 * (o.odom_alpha3 * h.travelled + o.odom_alpha4 * h.turned));
+  const double theta =
+      std::min(o.box_max_theta, o.box_min_theta + 3.0 * (o.odom_alpha1 * h.turned + o.odom_alpha2 * h.travelled));
+  return PoseBox{ p.x - xy, p.x + xy, p.y - xy, p.y + xy, p.theta - theta, p.theta + theta };
+}
+
+void HypothesisTracker::accumulateMotion(const Pose2& reference)
+{
+  if (have_reference_)
+  {
+    const Pose2 d = between(last_reference_, reference);
+    for (Hypothesis& h : hypotheses_)
+    {
+      h.travelled += std::hypot(d.x, d.y);
+      h.turned += std::abs(d.theta);
+    }
+  }
+  last_reference_ = reference;
+  have_reference_ = true;
+}
+
+void HypothesisTracker::seed(const std::vector<Candidate>& candidates, const Pose2& reference, double support)
+{
+  if (!have_reference_)
+  {
+    last_reference_ = reference;
+    have_reference_ = true;
+  }
+  for (const Candidate& c : candidates)
+  {
+    const auto duplicate = std::find_if(hypotheses_.begin(), hypotheses_.end(), [&](const Hypothesis& h) {
+      return samePlace(compose(h.map_to_odom, reference), c.pose, options_.merge_distance, options_.merge_angle);
+    });
+    if (duplicate != hypotheses_.end())
+    {
+      duplicate->support = std::max(duplicate->support, support);
+      continue;
+    }
+    Hypothesis h;
+    h.id = next_id_++;
+    h.map_to_odom = compose(c.pose, inverse(reference));
+    h.support = support;
+    h.last_fix = c;
+    hypotheses_.push_back(std::move(h));
+  }
+  if (!candidates.empty())
+  {
+    failed_updates_ = 0;
+  }
+  prune();
+}
+
+HintOutcome HypothesisTracker::seedFromHint(const PoseBox& box, const std::vector<Reading>& readings,
+                                            const Pose2& reference)
+{
+  const int k = static_cast<int>(readings.size());
+  LocalSolveSettings settings = solveSettings(k);
+  // A hint's box may be metres wide: coarser leaves (at most 64 per axis) and more seeds.
+  settings.cell_xy = std::max(settings.cell_xy, std::max(box.x1 - box.x0, box.y1 - box.y0) / 64.0);
+  settings.cell_theta = std::max(settings.cell_theta, (box.t1 - box.t0) / 64.0);
+  settings.max_seeds = std::max(settings.max_seeds, 2 * options_.max_hypotheses);
+  settings.max_boxes = 2000000;
+  const BoxOccupancy coarse(*map_, settings.cell_xy);
+  const LocalSolveOutcome found = localSolve(*map_, coarse, readings, box, settings);
+  HintOutcome outcome;
+  outcome.min_consensus = settings.min_consensus;
+  outcome.best_consensus = found.best_consensus;
+  if (found.fixes.empty())
+  {
+    return outcome;
+  }
+  clear();
+  failed_updates_ = 0;
+  seed(found.fixes, reference, options_.min_support);
+  outcome.accepted = true;
+  outcome.hypotheses = static_cast<int>(hypotheses_.size());
+  return outcome;
+}
+
+UpdateReport HypothesisTracker::update(const std::vector<Reading>& readings, const Pose2& reference)
+{
+  UpdateReport report;
+  const int k = static_cast<int>(readings.size());
+  const LocalSolveSettings settings = solveSettings(k);
+  report.min_consensus = settings.min_consensus;
+  accumulateMotion(reference);
+  for (Hypothesis& h : hypotheses_)
+  {
+    const PoseBox box = boxOf(h, reference);
+    const LocalSolveOutcome found = localSolve(*map_, occupancy_, readings, box, settings);
+    report.best_possible = std::max(report.best_possible, found.best_possible);
+    report.truncated = report.truncated || found.truncated;
+    if (found.fixes.empty())
+    {
+      // A miss earns what the best pose refined in the box explains (below k'; 0 when the
+      // search pruned the whole box): a solver's near miss costs less than an empty box.
+      ++h.misses;
+      ++report.missed;
+      h.support = options_.support_decay * h.support + std::max(0, found.best_consensus) / static_cast<double>(k);
+      continue;
+    }
+    // Among the fixes tied with the best on net consensus, the one nearest the prediction carries
+    // the hypothesis (the box is its uncertainty: new places come from global solves only).
+    const Pose2 predicted = box.centre();
+    const int best = netConsensus(found.fixes.front());
+    std::size_t chosen = 0;
+    for (std::size_t i = 1; i < found.fixes.size() && netConsensus(found.fixes[i]) == best; ++i)
+    {
+      if ((found.fixes[i].pose.position() - predicted.position()).norm() <
+          (found.fixes[chosen].pose.position() - predicted.position()).norm())
+      {
+        chosen = i;
+      }
+    }
+    const Candidate& fix = found.fixes[chosen];
+    h.map_to_odom = compose(fuse(predicted, box, fix), inverse(reference));
+    h.travelled = 0.0;
+    h.turned = 0.0;
+    h.misses = 0;
+    ++h.fixes;
+    h.support = options_.support_decay * h.support + static_cast<double>(netConsensus(fix)) / k;
+    h.last_fix = fix;
+    ++report.fixed;
+  }
+  failed_updates_ = report.fixed > 0 ? 0 : failed_updates_ + 1;
+  report.dropped = prune();
+  return report;
+}
+
+int HypothesisTracker::prune()
+{
+  const std::size_t before = hypotheses_.size();
+  hypotheses_.erase(std::remove_if(hypotheses_.begin(), hypotheses_.end(),
+                                   [&](const Hypothesis& h) { return h.misses >= options_.max_misses; }),
+                    hypotheses_.end());
+  std::stable_sort(hypotheses_.begin(), hypotheses_.end(), [](const Hypothesis& a, const Hypothesis& b) {
+    return a.support != b.support ? a.support > b.support : a.id < b.id;
+  });
+  std::vector<Hypothesis> kept;
+  for (Hypothesis& h : hypotheses_)
+  {
+    const Pose2 pose = compose(h.map_to_odom, last_reference_);
+    const bool duplicate = std::any_of(kept.begin(), kept.end(), [&](const Hypothesis& other) {
+      return samePlace(compose(other.map_to_odom, last_reference_), pose, options_.merge_distance,
+                       options_.merge_angle);
+    });
+    if (!duplicate && static_cast<int>(kept.size()) < options_.max_hypotheses)
+    {
+      kept.push_back(std::move(h));
+    }
+  }
+  hypotheses_ = std::move(kept);
+  return static_cast<int>(before - hypotheses_.size());
+}
+
+void HypothesisTracker::clear()
+{
+  hypotheses_.clear();
+  failed_updates_ = 0;
+}
+
+void HypothesisTracker::restore(std::vector<Hypothesis> hypotheses)
+{
+  hypotheses_ = std::move(hypotheses);
+  for (const Hypothesis& h : hypotheses_)
+  {
+    next_id_ = std::max(next_id_, h.id + 1);
+  }
+}
+
+const Hypothesis* HypothesisTracker::clearlySupported() const
+{
+  if (hypotheses_.empty())
+  {
+    return nullptr;
+  }
+  const Hypothesis& best = hypotheses_.front();
+  const double second = hypotheses_.size() > 1 ? hypotheses_[1].support : 0.0;
+  const bool clear = best.misses <= options_.tolerated_misses && best.support >= options_.min_support &&
+                     best.support - second >= options_.support_margin;
+  return clear ? &best : nullptr;
+}
+
+TrackState HypothesisTracker::state() const
+{
+  if (hypotheses_.empty())
+  {
+    return TrackState::Empty;
+  }
+  if (failed_updates_ >= options_.lost_updates)
+  {
+    return TrackState::Lost;
+  }
+  return clearlySupported() ? TrackState::Tracking : TrackState::Ambiguous;
+}
+
+}  // namespace core
+}  // namespace fdml_localization

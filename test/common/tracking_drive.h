@@ -1,0 +1,190 @@
+// A ROS-free drive for tracker tests and benchmarks: steps a Simulation and forms the batches
+// the node forms (the last k readings, g_i relative to the odometry base pose at the first one,
+// a new batch every `stride` readings), each with the true pose of the base at its first reading.
+#pragma once
+
+#include "fdml_localization/core/localization/localizer.h"
+#include "fdml_localization/simulation/simulation.h"
+
+#include <cmath>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <vector>
+
+namespace fdml_test
+{
+namespace core = fdml_localization::core;
+
+/// One batch as the node forms it.
+struct DriveBatch
+{
+  std::vector<core::Reading> readings;
+  core::Pose2 reference;  ///< odometry pose of the base at the first reading
+  core::Pose2 truth;      ///< true pose of the base at the first reading (map)
+  double time = 0.0;      ///< simulated time of the newest reading [s]
+  int obstacle_hits = 0;  ///< readings that hit an unknown obstacle
+};
+
+/// See the file comment.
+class Drive
+{
+public:
+  Drive(std::unique_ptr<core::Simulation> sim, int k, int stride) : sim_(std::move(sim)), k_(k), stride_(stride)
+  {}
+
+  /// Steps until the next batch is due; false after @p max_time simulated seconds.
+  bool next(DriveBatch* batch, double max_time)
+  {
+    core::StepOutput out;
+    while (sim_->time() < max_time)
+    {
+      sim_->step(&out);
+      for (const core::SimReading& r : out.readings)
+      {
+        const auto& sensor = sim_->config().sensors[r.sensor];
+        if (r.dropped || std::isnan(r.range) || r.range == -core::kInf)
+        {
+          continue;
+        }
+        Entry e;
+        e.odom_base = sim_->odomPose();
+        e.truth_base = sim_->truePose();
+        e.sensor_in_odom = core::compose(e.odom_base, sensor.mount);
+        e.range = r.range;
+        e.max_range = sensor.max_range;
+        e.obstacle = r.kind == core::SceneHit::Kind::Obstacle;
+        e.time = r.time;
+        window_.push_back(e);
+        ++since_batch_;
+      }
+      while (static_cast<int>(window_.size()) > k_)
+      {
+        window_.pop_front();
+      }
+      if (static_cast<int>(window_.size()) == k_ && since_batch_ >= stride_)
+      {
+        since_batch_ = 0;
+        fill(batch);
+        return true;
+      }
+    }
+    return false;
+  }
+
+  core::Simulation& sim()
+  {
+    return *sim_;
+  }
+
+private:
+  struct Entry
+  {
+    core::Pose2 odom_base, truth_base, sensor_in_odom;
+    double range = 0.0, max_range = 0.0, time = 0.0;
+    bool obstacle = false;
+  };
+
+  void fill(DriveBatch* batch) const
+  {
+    batch->readings.clear();
+    batch->obstacle_hits = 0;
+    batch->reference = window_.front().odom_base;
+    batch->truth = window_.front().truth_base;
+    batch->time = window_.back().time;
+    for (const Entry& e : window_)
+    {
+      core::Reading reading;
+      reading.offset = core::between(batch->reference, e.sensor_in_odom);
+      reading.range = e.range;
+      reading.max_range = e.max_range;
+      batch->readings.push_back(reading);
+      batch->obstacle_hits += e.obstacle ? 1 : 0;
+    }
+  }
+
+  std::unique_ptr<core::Simulation> sim_;
+  int k_;
+  int stride_;
+  int since_batch_ = 0;
+  std::deque<Entry> window_;
+};
+
+/// Four range sensors (front, left, back, right) at @p rate [Hz].
+inline std::vector<core::SensorConfig> fourSensors(double rate, double max_range, double noise)
+{
+  std::vector<core::SensorConfig> sensors;
+  const char* frames[] = { "front", "left", "back", "right" };
+  for (int i = 0; i < 4; ++i)
+  {
+    core::SensorConfig s;
+    s.frame = frames[i];
+    const double a = i * 0.5 * M_PI;
+    s.mount = core::Pose2(0.15 * std::cos(a), 0.15 * std::sin(a), a);
+    s.rate = rate;
+    s.max_range = max_range;
+    s.noise_sigma = noise;
+    sensors.push_back(s);
+  }
+  return sensors;
+}
+
+/// A robot driving a loop of @p waypoints (starting at the first) at 0.4 m/s with fourSensors(10 Hz,
+/// @p max_range, 1 cm noise) and odometry drifting by @p drift per metre and per radian.
+inline core::ScenarioConfig waypointScenario(std::vector<core::Vec2> waypoints, double max_range, double drift,
+                                             std::uint64_t seed)
+{
+  core::ScenarioConfig c;
+  c.seed = seed;
+  c.step_rate = 50;
+  c.robot.radius = 0.18;
+  c.robot.random_start = false;
+  c.robot.start = core::Pose2(waypoints.front().x(), waypoints.front().y(), 0.0);
+  c.robot.motion = core::RobotMotion::Waypoints;
+  c.robot.linear_speed = 0.4;
+  c.robot.angular_speed = 0.8;
+  c.robot.waypoints = std::move(waypoints);
+  c.sensors = fourSensors(10.0, max_range, 0.01);
+  c.odometry.rate = 50;
+  c.odometry.translation_noise = drift;
+  c.odometry.rotation_noise = drift;
+  return c;
+}
+
+/// The apartment patrol (config/scenarios/apartment_patrol.yaml): four rooms through their doors,
+/// 3 % odometry drift, @p people walking at random.
+inline core::ScenarioConfig apartmentPatrol(int people)
+{
+  core::ScenarioConfig c = waypointScenario({ { 1.5, 1.0 },
+                                              { 5.5, 1.0 },
+                                              { 5.5, 2.0 },
+                                              { 8.3, 2.0 },
+                                              { 8.3, 3.3 },
+                                              { 11.3, 3.3 },
+                                              { 11.3, 0.8 },
+                                              { 8.3, 0.8 },
+                                              { 8.3, 2.0 },
+                                              { 2.8, 2.0 },
+                                              { 2.8, 5.7 },
+                                              { 8.0, 5.7 },
+                                              { 8.0, 7.5 },
+                                              { 10.5, 7.5 },
+                                              { 10.5, 5.0 },
+                                              { 8.0, 5.0 },
+                                              { 8.0, 5.7 },
+                                              { 2.8, 5.7 },
+                                              { 2.8, 2.0 } },
+                                            8.0, 0.03, 5);
+  if (people > 0)
+  {
+    core::ObstacleGroupConfig g;
+    g.count = people;
+    g.radius = 0.25;
+    g.motion = core::ObstacleMotion::RandomWalk;
+    g.speed = 0.5;
+    c.obstacles.push_back(g);
+  }
+  return c;
+}
+
+}  // namespace fdml_test

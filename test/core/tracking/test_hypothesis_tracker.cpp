@@ -1,0 +1,223 @@
+// Tests of the hypothesis tracker over simulated drives (ROS-free simulation library): carried by
+// odometry, support earned over time, a kidnap detected, twin rooms ambiguous until left.
+#include "fdml_localization/core/map/map_io.h"
+#include "fdml_localization/core/tracking/hypothesis_tracker.h"
+#include "tracking_drive.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <string>
+
+namespace core = fdml_localization::core;
+using fdml_test::Drive;
+using fdml_test::DriveBatch;
+
+namespace
+{
+std::shared_ptr<const core::MapRayCaster> apartment()
+{
+  return std::make_shared<const core::MapRayCaster>(core::loadPolyFile(std::string(FDML_SOURCE_DIR) + "/maps/"
+                                                                                                      "apartment."
+                                                                                                      "poly"));
+}
+
+std::unique_ptr<core::Simulation> simulate(const core::ScenarioConfig& config,
+                                           std::shared_ptr<const core::MapRayCaster> map)
+{
+  std::vector<std::string> errors;
+  auto sim = core::Simulation::create(config, std::move(map), &errors);
+  if (!errors.empty())
+  {
+    ADD_FAILURE() << errors.front();
+    std::abort();
+  }
+  return sim;
+}
+
+bool right(const core::Pose2& pose, const core::Pose2& truth)
+{
+  return (pose.position() - truth.position()).norm() <= 0.1 &&
+         std::abs(core::angleDiff(pose.theta, truth.theta)) <= 5.0 * M_PI / 180.0;
+}
+
+/// The candidate at the true pose of @p batch (what a global solve would give).
+core::Candidate truthCandidate(const DriveBatch& batch)
+{
+  core::Candidate c;
+  c.pose = batch.truth;
+  return c;
+}
+
+core::TrackerOptions options()
+{
+  core::TrackerOptions o;
+  return o;
+}
+}  // namespace
+
+TEST(HypothesisTracker, CarriedByOdometryAmongPeople)
+{
+  const auto map = apartment();
+  Drive drive(simulate(fdml_test::apartmentPatrol(5), map), 10, 2);
+  core::HypothesisTracker tracker(map, options());
+  DriveBatch batch;
+  ASSERT_TRUE(drive.next(&batch, 60.0));
+  tracker.seed({ truthCandidate(batch) }, batch.reference, 0.0);
+  int updates = 0, published = 0, published_right = 0, spoiled = 0;
+  while (drive.next(&batch, 60.0))
+  {
+    tracker.update(batch.readings, batch.reference);
+    ++updates;
+    spoiled += batch.obstacle_hits >= 2 ? 1 : 0;
+    const core::Hypothesis* best = tracker.clearlySupported();
+    if (best)
+    {
+      ++published;
+      const core::Pose2 pose = core::compose(best->map_to_odom, batch.reference);
+      published_right += right(pose, batch.truth) ? 1 : 0;
+      EXPECT_TRUE(right(pose, batch.truth))
+          << "at " << batch.time << " s: (" << pose.x << ", " << pose.y << ", " << pose.theta << ") vs truth ("
+          << batch.truth.x << ", " << batch.truth.y << ", " << batch.truth.theta << ")";
+    }
+  }
+  EXPECT_GT(updates, 500);
+  EXPECT_GE(spoiled, 20) << "the people should spoil some batches";
+  // The seeded hypothesis earns support within a few updates and keeps it.
+  EXPECT_GE(published, updates * 97 / 100) << published << " of " << updates;
+  EXPECT_EQ(published_right, published);
+}
+
+TEST(HypothesisTracker, LoneWeakHypothesisIsNotClearlySupported)
+{
+  const auto map = apartment();
+  Drive drive(simulate(fdml_test::apartmentPatrol(0), map), 10, 2);
+  core::HypothesisTracker tracker(map, options());
+  DriveBatch batch;
+  ASSERT_TRUE(drive.next(&batch, 10.0));
+  tracker.seed({ truthCandidate(batch) }, batch.reference, 0.0);
+  EXPECT_EQ(tracker.clearlySupported(), nullptr);
+  EXPECT_EQ(tracker.state(), core::TrackState::Ambiguous);
+  int updates = 0;
+  while (!tracker.clearlySupported() && drive.next(&batch, 10.0))
+  {
+    tracker.update(batch.readings, batch.reference);
+    ++updates;
+  }
+  // Support 1 per perfect update, decayed by 0.95: min_support 3 needs at least 4 updates.
+  EXPECT_GE(updates, 4);
+  EXPECT_LE(updates, 8);
+  EXPECT_EQ(tracker.state(), core::TrackState::Tracking);
+}
+
+TEST(HypothesisTracker, KidnapIsDetectedAndNeverPublishedLong)
+{
+  const auto map = apartment();
+  Drive drive(simulate(fdml_test::apartmentPatrol(3), map), 10, 2);
+  core::HypothesisTracker tracker(map, options());
+  DriveBatch batch;
+  ASSERT_TRUE(drive.next(&batch, 20.0));
+  tracker.seed({ truthCandidate(batch) }, batch.reference, 0.0);
+  while (drive.next(&batch, 10.0))
+  {
+    tracker.update(batch.readings, batch.reference);
+  }
+  ASSERT_EQ(tracker.state(), core::TrackState::Tracking);
+  std::string message;
+  ASSERT_TRUE(drive.sim().kidnap(core::Pose2(9.5, 6.5, 1.0), &message)) << message;
+  int updates = 0, wrong = 0;
+  while (tracker.state() != core::TrackState::Lost && drive.next(&batch, 20.0))
+  {
+    tracker.update(batch.readings, batch.reference);
+    ++updates;
+    const core::Hypothesis* best = tracker.clearlySupported();
+    wrong += best && !right(core::compose(best->map_to_odom, batch.reference), batch.truth) ? 1 : 0;
+  }
+  EXPECT_EQ(tracker.state(), core::TrackState::Lost);
+  // Batches straddling the kidnap (k / stride = 5 of them) may still fit the old pose; then at
+  // most tolerated_misses + lost_updates more.
+  EXPECT_LE(updates, 5 + options().lost_updates + 2);
+  EXPECT_LE(wrong, 5 + options().tolerated_misses + 1);
+}
+
+namespace
+{
+/// Two identical rooms side by side (x in [0, 4] and [6, 10], y in [0, 4]), each with a door in
+/// its top wall at the same place, opening onto a corridor (y in [4.2, 5.7], x in [0, 16]) that
+/// is not symmetric: its left end is 2 m from the left room's door, 8 m from the right one's.
+core::PolygonMap twinRooms()
+{
+  return core::PolygonMap::fromRings(
+      { { { 0, 0 },    { 4, 0 },   { 4, 4 },   { 2.3, 4 },   { 2.3, 4.2 }, { 7.7, 4.2 }, { 7.7, 4 },
+          { 6, 4 },    { 6, 0 },   { 10, 0 },  { 10, 4 },    { 8.3, 4 },   { 8.3, 4.2 }, { 16, 4.2 },
+          { 16, 5.7 }, { 0, 5.7 }, { 0, 4.2 }, { 1.7, 4.2 }, { 1.7, 4 },   { 0, 4 } } });
+}
+}  // namespace
+
+TEST(HypothesisTracker, TwinRoomsStayAmbiguousUntilTheRobotLeaves)
+{
+  const auto map = std::make_shared<const core::MapRayCaster>(twinRooms());
+  // Twice round the left room, then out through the door to the corridor's left end.
+  core::ScenarioConfig c = fdml_test::waypointScenario({ { 1.0, 1.0 },
+                                                         { 3.0, 1.0 },
+                                                         { 3.0, 2.6 },
+                                                         { 1.0, 2.6 },
+                                                         { 1.0, 1.0 },
+                                                         { 3.0, 1.0 },
+                                                         { 3.0, 2.6 },
+                                                         { 2.0, 2.6 },
+                                                         { 2.0, 4.95 },
+                                                         { 0.6, 4.95 },
+                                                         { 2.0, 4.95 },
+                                                         { 2.0, 2.6 } },
+                                                       2.5, 0.02, 3);
+  c.robot.radius = 0.15;
+  Drive drive(simulate(c, map), 10, 2);
+  core::HypothesisTracker tracker(map, options());
+  DriveBatch batch;
+  ASSERT_TRUE(drive.next(&batch, 5.0));
+  core::Candidate twin = truthCandidate(batch);
+  twin.pose.x += 6.0;
+  tracker.seed({ truthCandidate(batch), twin }, batch.reference, 0.0);
+  int in_rooms = 0, resolved_outside = 0;
+  while (drive.next(&batch, 60.0))
+  {
+    tracker.update(batch.readings, batch.reference);
+    const core::Hypothesis* best = tracker.clearlySupported();
+    const bool inside = batch.truth.y < 3.3;
+    if (best)
+    {
+      EXPECT_TRUE(right(core::compose(best->map_to_odom, batch.reference), batch.truth))
+          << "a wrong pose is clearly supported at " << batch.time << " s: " << best->map_to_odom.x << ", "
+          << core::compose(best->map_to_odom, batch.reference).x << ", "
+          << core::compose(best->map_to_odom, batch.reference).y << ", "
+          << core::compose(best->map_to_odom, batch.reference).theta << " truth " << batch.truth.x << ", "
+          << batch.truth.y << ", " << batch.truth.theta << " hyps " << tracker.hypotheses().size();
+    }
+    if (inside)
+    {
+      ++in_rooms;
+      EXPECT_EQ(best, nullptr) << "clearly supported inside a twin room at " << batch.time << " s";
+    }
+    else if (best && batch.truth.x < 1.2)
+    {
+      ++resolved_outside;
+    }
+  }
+  EXPECT_GT(in_rooms, 100);
+  EXPECT_GT(resolved_outside, 0) << "the right pose was never clearly supported after leaving the rooms";
+}
+
+TEST(HypothesisTracker, OptionsAreValidated)
+{
+  core::TrackerOptions o;
+  EXPECT_TRUE(core::validate(o).empty());
+  o.support_decay = 1.0;
+  o.cell_xy = 0.5;
+  o.max_hypotheses = 0;
+  const auto errors = core::validate(o, [](const std::string& n) { return "~tracker_" + n; });
+  ASSERT_EQ(errors.size(), 3u);
+  EXPECT_NE(errors[0].find("~tracker_cell_xy"), std::string::npos) << errors[0];
+  EXPECT_THROW(core::HypothesisTracker(apartment(), o), std::invalid_argument);
+}

@@ -1,0 +1,104 @@
+// Tests of the local solve: the box search restricted to a region (AdaptiveSearchOptions::region)
+// never loses a pose of the box that explains the readings, and a box without one holds no fix.
+#include "fdml_localization/core/map/map_io.h"
+#include "fdml_localization/core/tracking/local_solve.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+
+namespace core = fdml_localization::core;
+
+namespace
+{
+std::shared_ptr<const core::MapRayCaster> apartment()
+{
+  return std::make_shared<const core::MapRayCaster>(core::loadPolyFile(std::string(FDML_SOURCE_DIR) + "/maps/"
+                                                                                                      "apartment."
+                                                                                                      "poly"));
+}
+
+/// k readings from @p truth: four sensors at several headings of a turn.
+std::vector<core::Reading> readingsAt(const core::MapRayCaster& map, const core::Pose2& truth, int k)
+{
+  std::vector<core::Reading> readings;
+  for (int i = 0; i < k; ++i)
+  {
+    core::Reading r;
+    r.offset = core::Pose2(0.15 * std::cos(i * 0.5 * M_PI), 0.15 * std::sin(i * 0.5 * M_PI), i * 0.5 * M_PI + 0.1 * i);
+    r.max_range = 8.0;
+    r.range = map.range(core::compose(truth, r.offset), r.max_range);
+    readings.push_back(r);
+  }
+  return readings;
+}
+
+core::PoseBox around(const core::Pose2& p, double xy, double theta)
+{
+  return core::PoseBox{ p.x - xy, p.x + xy, p.y - xy, p.y + xy, p.theta - theta, p.theta + theta };
+}
+}  // namespace
+
+TEST(LocalSolve, FindsTheTruthInEveryBoxHoldingIt)
+{
+  const auto map = apartment();
+  const core::BoxOccupancy occupancy(*map, 0.05);
+  core::LocalSolveSettings settings;
+  settings.min_consensus = 8;
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> off(-0.2, 0.2), turn(-0.1, 0.1);
+  const core::Pose2 poses[] = { { 2.0, 2.0, 0.3 }, { 9.0, 3.0, -2.0 }, { 5.0, 5.7, 3.1 }, { 9.5, 7.0, 1.0 } };
+  for (const core::Pose2& truth : poses)
+  {
+    const auto readings = readingsAt(*map, truth, 10);
+    // A box around a prediction off by up to 0.2 m and 0.1 rad, holding the truth.
+    const core::Pose2 predicted(truth.x + off(rng), truth.y + off(rng), truth.theta + turn(rng));
+    const core::LocalSolveOutcome found =
+        core::localSolve(*map, occupancy, readings, around(predicted, 0.3, 0.2), settings);
+    ASSERT_FALSE(found.fixes.empty()) << "truth " << truth.x << ", " << truth.y;
+    EXPECT_LT((found.fixes[0].pose.position() - truth.position()).norm(), 0.01);
+    EXPECT_LT(std::abs(core::angleDiff(found.fixes[0].pose.theta, truth.theta)), 0.01);
+    EXPECT_EQ(found.best_possible, 10);
+    // A box 1 m away holds no pose explaining them.
+    const core::Pose2 away(truth.x + 1.0, truth.y, truth.theta);
+    const core::LocalSolveOutcome none = core::localSolve(*map, occupancy, readings, around(away, 0.3, 0.2), settings);
+    EXPECT_TRUE(none.fixes.empty());
+    EXPECT_LT(none.best_possible, 10);
+  }
+}
+
+TEST(LocalSolve, RegionSearchKeepsEveryLeafTheWholeSearchKeeps)
+{
+  const auto map = apartment();
+  const core::BoxOccupancy occupancy(*map, 0.1);
+  const core::Pose2 truth(3.0, 2.5, 0.7);
+  const auto readings = readingsAt(*map, truth, 8);
+  core::AdaptiveSearchOptions whole;
+  whole.cell_xy = 0.1;
+  whole.cell_theta = 0.05;
+  whole.min_count = 7;
+  whole.threads = 1;
+  core::AdaptiveSearchOptions local = whole;
+  local.region = around(truth, 0.5, 0.3);
+  const auto all = core::adaptiveSearch(*map, occupancy, readings, whole);
+  const auto inside = core::adaptiveSearch(*map, occupancy, readings, local);
+  ASSERT_FALSE(inside.leaves.empty());
+  // Every leaf of the whole search whose centre lies well inside the region is covered by a
+  // leaf of the region's search (conservative: no false negative inside the box).
+  for (const core::LeafBox& leaf : all.leaves)
+  {
+    const core::Pose2 c = leaf.box.centre();
+    if (!core::insideBox(c, *local.region, -0.1, -0.05))
+    {
+      continue;
+    }
+    bool covered = false;
+    for (const core::LeafBox& l : inside.leaves)
+    {
+      covered = covered || core::insideBox(c, l.box, 0.1, 0.05);
+    }
+    EXPECT_TRUE(covered) << c.x << ", " << c.y << ", " << c.theta;
+  }
+}

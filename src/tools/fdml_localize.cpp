@@ -9,8 +9,10 @@
 // [m, rad]; d may be "inf" (no return within max_range). Prints "rank,x,y,theta,inliers,rms"
 // and one candidate per line, best first; exit 0 (also with no candidate), 2 on bad input.
 #include "fdml_localization/core/localization/localizer.h"
-#include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/core/localization/ranking.h"
+#include "fdml_localization/core/localization/voxel/table_cache.h"
+#include "fdml_localization/core/map/map_io.h"
+#include "fdml_localization/core/util/file_checks.h"
 #include "fdml_localization/core/util/text_parsing.h"
 
 #include <cerrno>
@@ -19,6 +21,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -56,76 +59,128 @@ std::vector<std::string> splitCsv(const std::string& line)
   return fields;
 }
 
-std::vector<core::Reading> readCsv(const std::string& path, double default_max_range)
+/// The readings of a CSV file, each with the line it came from.
+struct CsvReadings
 {
-  std::ifstream in(path);
-  if (!in)
+  std::vector<core::Reading> readings;
+  std::vector<int> lines;
+};
+
+/// Reads the header line; returns whether it has the max_range column.
+bool readHeader(const std::string& where, const std::string& text)
+{
+  if (text == "gx,gy,gtheta,d")
   {
-    throw UsageError(path + ": cannot open");
+    return false;
+  }
+  if (text == "gx,gy,gtheta,d,max_range")
+  {
+    return true;
+  }
+  throw UsageError(where + ": expected the header 'gx,gy,gtheta,d' (optionally ',max_range'), got '" + text + "'");
+}
+
+core::Reading parseReading(const std::string& where, const std::string& text, bool has_max_range,
+                           double default_max_range)
+{
+  const std::vector<std::string> fields = splitCsv(text);
+  const std::size_t expected = has_max_range ? 5 : 4;
+  if (fields.size() != expected)
+  {
+    throw UsageError(where + ": expected " + std::to_string(expected) + " fields, got " +
+                     std::to_string(fields.size()));
+  }
+  core::Reading r;
+  r.offset.x = core::parseNumber(fields[0], where + ": gx", true);
+  r.offset.y = core::parseNumber(fields[1], where + ": gy", true);
+  r.offset.theta = core::parseNumber(fields[2], where + ": gtheta", true);
+  r.range = core::parseNumber(fields[3], where + ": d", true);
+  r.max_range = has_max_range ? core::parseNumber(fields[4], where + ": max_range", true) : default_max_range;
+  if (!std::isfinite(r.offset.x) || !std::isfinite(r.offset.y) || !std::isfinite(r.offset.theta))
+  {
+    throw UsageError(where + ": gx, gy and gtheta must be finite");
+  }
+  if (std::isnan(r.range) || r.range < 0.0)
+  {
+    throw UsageError(where + ": d must be >= 0 or inf, got " + fields[3]);
+  }
+  if (std::isinf(r.range) && !std::isfinite(r.max_range))
+  {
+    throw UsageError(where + ": d = inf needs a finite max range (--max-range or a max_range column)");
+  }
+  return r;
+}
+
+CsvReadings readCsv(const std::string& path, double default_max_range)
+{
+  const std::string problem = core::regularFileProblem(path);
+  std::ifstream in;
+  if (problem.empty())
+  {
+    in.open(path);
+  }
+  if (!problem.empty() || !in)
+  {
+    throw UsageError(path + ": cannot open the readings file" + (problem.empty() ? "" : ": " + problem));
   }
   std::string line;
   int line_no = 0;
   bool have_header = false;
   bool has_max_range = false;
-  std::vector<core::Reading> readings;
+  CsvReadings csv;
   while (std::getline(in, line))
   {
     ++line_no;
+    const std::string where = path + ":" + std::to_string(line_no);
+    if (line.find('\0') != std::string::npos)
+    {
+      throw UsageError(where + ": NUL byte in the line (not a text file?)");
+    }
     const std::string t = core::trim(line);
     if (t.empty() || t[0] == '#')
     {
       continue;
     }
-    const std::string where = path + ":" + std::to_string(line_no);
-    const std::vector<std::string> fields = splitCsv(t);
     if (!have_header)
     {
-      if (t == "gx,gy,gtheta,d")
-      {
-        has_max_range = false;
-      }
-      else if (t == "gx,gy,gtheta,d,max_range")
-      {
-        has_max_range = true;
-      }
-      else
-      {
-        throw UsageError(where + ": expected the header 'gx,gy,gtheta,d' (optionally ',max_range'), got '" + t + "'");
-      }
+      has_max_range = readHeader(where, t);
       have_header = true;
       continue;
     }
-    const std::size_t expected = has_max_range ? 5 : 4;
-    if (fields.size() != expected)
-    {
-      throw UsageError(where + ": expected " + std::to_string(expected) + " fields, got " +
-                       std::to_string(fields.size()));
-    }
-    core::Reading r;
-    r.offset.x = core::parseNumber(fields[0], where + ": gx", true);
-    r.offset.y = core::parseNumber(fields[1], where + ": gy", true);
-    r.offset.theta = core::parseNumber(fields[2], where + ": gtheta", true);
-    r.range = core::parseNumber(fields[3], where + ": d", true);
-    r.max_range = has_max_range ? core::parseNumber(fields[4], where + ": max_range", true) : default_max_range;
-    if (!std::isfinite(r.offset.x) || !std::isfinite(r.offset.y) || !std::isfinite(r.offset.theta))
-    {
-      throw UsageError(where + ": gx, gy and gtheta must be finite");
-    }
-    if (std::isnan(r.range) || r.range < 0.0)
-    {
-      throw UsageError(where + ": d must be >= 0 or inf, got " + fields[3]);
-    }
-    if (std::isinf(r.range) && !std::isfinite(r.max_range))
-    {
-      throw UsageError(where + ": d = inf needs a finite max range (--max-range or a max_range column)");
-    }
-    readings.push_back(r);
+    csv.readings.push_back(parseReading(where, t, has_max_range, default_max_range));
+    csv.lines.push_back(line_no);
   }
   if (!have_header)
   {
     throw UsageError(path + ": empty file (expected the header 'gx,gy,gtheta,d')");
   }
-  return readings;
+  return csv;
+}
+
+/// The core's check of the batch, its errors naming the file and line ("reading N: ..." from
+/// core::validateReadings becomes "FILE:LINE: ...").
+void validateCsv(const CsvReadings& csv, const std::string& path, const core::LocalizerOptions& options)
+{
+  try
+  {
+    core::validateReadings(csv.readings, options);
+  }
+  catch (const core::InvalidInput& e)
+  {
+    const std::string what = e.what();
+    const std::string prefix = "reading ";
+    const std::size_t colon = what.find(": ");
+    if (what.rfind(prefix, 0) == 0 && colon != std::string::npos && colon > prefix.size() &&
+        what.find_first_not_of("0123456789", prefix.size()) == colon)
+    {
+      const std::size_t index = std::stoul(what.substr(prefix.size(), colon - prefix.size()));
+      if (index < csv.lines.size())
+      {
+        throw UsageError(path + ":" + std::to_string(csv.lines[index]) + what.substr(colon));
+      }
+    }
+    throw UsageError(path + ": " + what);
+  }
 }
 
 struct Arguments
@@ -136,6 +191,63 @@ struct Arguments
   double max_range = core::kInf;
   bool verbose = false;
 };
+
+/// Applies one option flag that takes a value; false when @p flag is not one of them.
+bool applyValueFlag(const std::string& flag, const std::function<std::string()>& value, Arguments& args)
+{
+  core::LocalizerOptions& o = args.options;
+  if (flag == "--map")
+  {
+    args.map = value();
+  }
+  else if (flag == "--resolution" || flag == "--theta-resolution" || flag == "--threads" || flag == "--max-candidates")
+  {
+    const int n = core::parseInteger(value(), flag);
+    int& target = flag == "--resolution"       ? o.resolution :
+                  flag == "--theta-resolution" ? o.theta_resolution :
+                  flag == "--threads"          ? o.threads :
+                                                 o.max_candidates;
+    target = n;
+  }
+  else if (flag == "--min-inliers")
+  {
+    const std::string v = value();
+    o.min_inliers = v == "auto" ? 0 : core::parseInteger(v, flag);
+    if (v != "auto" && o.min_inliers < 3)
+    {
+      throw UsageError("--min-inliers " + v + ": must be 'auto' or an integer >= 3");
+    }
+  }
+  else if (flag == "--method")
+  {
+    o.method = core::parseMethod(value());
+  }
+  else if (flag == "--engine")
+  {
+    o.engine = core::parseEngine(value());
+  }
+  else if (flag == "--range-tolerance")
+  {
+    o.range_tolerance = core::parseNumber(value(), flag);
+  }
+  else if (flag == "--tolerance")
+  {
+    o.agreement_tolerance = core::parseNumber(value(), flag);
+  }
+  else if (flag == "--cache-dir")
+  {
+    o.cache_dir = value();
+  }
+  else if (flag == "--max-range")
+  {
+    args.max_range = core::parseNumber(value(), flag, true);
+  }
+  else
+  {
+    return false;
+  }
+  return true;
+}
 
 Arguments parseArguments(int argc, char** argv)
 {
@@ -150,60 +262,11 @@ Arguments parseArguments(int argc, char** argv)
       }
       return argv[++i];
     };
-    if (flag == "--map")
+    if (applyValueFlag(flag, value, args))
     {
-      args.map = value();
+      continue;
     }
-    else if (flag == "--resolution")
-    {
-      args.options.resolution = core::parseInteger(value(), flag);
-    }
-    else if (flag == "--theta-resolution")
-    {
-      args.options.theta_resolution = core::parseInteger(value(), flag);
-    }
-    else if (flag == "--min-inliers")
-    {
-      const std::string v = value();
-      args.options.min_inliers = v == "auto" ? 0 : core::parseInteger(v, flag);
-      if (v != "auto" && args.options.min_inliers < 3)
-      {
-        throw UsageError("--min-inliers " + v + ": must be 'auto' or an integer >= 3");
-      }
-    }
-    else if (flag == "--method")
-    {
-      args.options.method = core::parseMethod(value());
-    }
-    else if (flag == "--engine")
-    {
-      args.options.engine = core::parseEngine(value());
-    }
-    else if (flag == "--range-tolerance")
-    {
-      args.options.range_tolerance = core::parseNumber(value(), flag);
-    }
-    else if (flag == "--tolerance")
-    {
-      args.options.agreement_tolerance = core::parseNumber(value(), flag);
-    }
-    else if (flag == "--threads")
-    {
-      args.options.threads = core::parseInteger(value(), flag);
-    }
-    else if (flag == "--cache-dir")
-    {
-      args.options.cache_dir = value();
-    }
-    else if (flag == "--max-candidates")
-    {
-      args.options.max_candidates = core::parseInteger(value(), flag);
-    }
-    else if (flag == "--max-range")
-    {
-      args.max_range = core::parseNumber(value(), flag, true);
-    }
-    else if (flag == "--verbose")
+    if (flag == "--verbose")
     {
       args.verbose = true;
     }
@@ -294,10 +357,16 @@ int main(int argc, char** argv)
       }
       throw UsageError(text);
     }
-    const std::vector<core::Reading> readings = readCsv(args.csv, args.max_range);
+    const CsvReadings csv = readCsv(args.csv, args.max_range);
+    validateCsv(csv, args.csv, args.options);
     auto map = std::make_shared<const core::MapRayCaster>(core::loadPolyFile(args.map));
     core::Localizer localizer(map, args.options);
-    const core::Result result = localizer.localize(readings);
+    const core::Result result = localizer.localize(csv.readings);
+    const std::string cache_warning = core::tableCacheWarning(localizer);
+    if (!cache_warning.empty())
+    {
+      std::cerr << "fdml_localize: warning: distance-table cache: " << cache_warning << "\n";
+    }
     printResult(result);
     if (args.verbose)
     {

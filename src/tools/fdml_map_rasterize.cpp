@@ -12,10 +12,12 @@
 #include "fdml_localization/core/util/text_parsing.h"
 #include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/io/map_files.h"
+#include "fdml_localization/io/map_image.h"
 
 #include <cmath>
 #include <functional>
 #include <iostream>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -43,6 +45,27 @@ int parseCount(const std::string& text, const std::string& option)
     throw std::invalid_argument(option + " must be a non-negative integer");
   }
   return static_cast<int>(v);
+}
+
+/// Refuses a grid beyond the map image limits (io::kMaxGridSide, io::kMaxGridCells) before it
+/// is allocated: a map of huge coordinates would otherwise exhaust memory.
+void checkGridSize(const std::string& input, const core::PolygonMap& map, const core::RasterizeOptions& o)
+{
+  if (!(o.resolution > 0.0) || !std::isfinite(o.margin))
+  {
+    return;  // core::rasterize() names the bad option
+  }
+  const double width = std::ceil((map.bounds().size().x() + 2.0 * o.margin) / o.resolution);
+  const double height = std::ceil((map.bounds().size().y() + 2.0 * o.margin) / o.resolution);
+  if (!(width <= io::kMaxGridSide && height <= io::kMaxGridSide &&
+        width * height <= static_cast<double>(io::kMaxGridCells)))
+  {
+    std::ostringstream os;
+    os << input << ": the grid would be " << width << " x " << height << " cells at " << o.resolution
+       << " m, beyond the limit (each side at most " << io::kMaxGridSide << ", at most " << io::kMaxGridCells / 1000000
+       << " M cells): use a coarser --resolution";
+    throw std::invalid_argument(os.str());
+  }
 }
 
 struct Arguments
@@ -146,6 +169,7 @@ int main(int argc, char** argv)
   try
   {
     const core::PolygonMap map = core::loadPolyFile(args.input);
+    checkGridSize(args.input, map, args.options);
     const core::OccupancyGrid grid = core::rasterize(map, args.options);
     io::saveOccupancyGridYaml(args.output, grid);
     std::cout << args.input << " -> " << args.output << ": " << grid.width << " x " << grid.height << " cells at "

@@ -1,14 +1,11 @@
-// validateRings: the rings of a map checked in O(n log n) typical time with a uniform grid of
-// edges (each edge meets only the edges sharing one of its cells), with the verdicts of the
-// OGC rules Boost.Geometry's is_valid applies (test_ring_validation.cpp compares the two):
-// every ring simple (no edge meets a non-adjacent edge, no spike), rings of a polygon meeting
-// only at single points, never in a cycle (which would split the free space), holes inside the
-// outer ring and not inside each other.
+// validateRings in O(n log n) typical time (SegmentBuckets: each edge meets only the edges
+// sharing one of its cells), with the verdicts of Boost.Geometry's is_valid (the OGC rules;
+// test_ring_validation.cpp compares the two).
 #include "fdml_localization/core/map/polygon_map.h"
+#include "fdml_localization/core/map/segment_buckets.h"
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 #include <map>
 #include <numeric>
 #include <tuple>
@@ -123,118 +120,6 @@ bool isSpike(const Vec2& before, const Vec2& shared, const Vec2& after)
   return std::abs(u.x() * w.y() - u.y() * w.x()) <= 1e-12 * u.norm() * w.norm() && u.dot(w) > 0.0;
 }
 
-/// A sparse uniform grid over the edges, with cells the size of the mean edge, so that an edge
-/// passes through a few cells and a cell holds a few edges even where the edges crowd along
-/// walls. Every edge is listed in the cells it passes through (with a one-cell margin across,
-/// so rounding never loses a contact); only occupied cells are stored (sorted keys).
-class SegmentGrid
-{
-public:
-  explicit SegmentGrid(const std::vector<Edge>& edges) : edges_(edges), stamp_(edges.size(), 0)
-  {
-    Box2 box;
-    double length = 0.0;
-    for (const Edge& e : edges)
-    {
-      box.extend(e.seg.a);
-      box.extend(e.seg.b);
-      length += (e.seg.b - e.seg.a).norm();
-    }
-    if (box.empty())
-    {
-      box.extend(Vec2(0.0, 0.0));
-    }
-    origin_ = box.min;
-    const double extent = std::max(box.max.x() - box.min.x(), box.max.y() - box.min.y());
-    cell_ = std::max(length / static_cast<double>(std::max<std::size_t>(edges.size(), 1)), extent / kMaxCells);
-    if (!(cell_ > 0.0))
-    {
-      cell_ = 1.0;
-    }
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> entries;
-    for (std::size_t i = 0; i < edges.size(); ++i)
-    {
-      forEachCell(edges[i].seg, [&](std::uint64_t key) { entries.emplace_back(key, static_cast<std::uint32_t>(i)); });
-    }
-    std::sort(entries.begin(), entries.end());
-    items_.reserve(entries.size());
-    for (const auto& [key, edge] : entries)
-    {
-      if (keys_.empty() || keys_.back() != key)
-      {
-        keys_.push_back(key);
-        start_.push_back(static_cast<std::uint32_t>(items_.size()));
-      }
-      items_.push_back(edge);
-    }
-    start_.push_back(static_cast<std::uint32_t>(items_.size()));
-  }
-
-  /// Calls visit(j) once for every edge j > i sharing a cell with edge i.
-  template <class Visit>
-  void forEachLaterNeighbour(std::size_t i, Visit visit)
-  {
-    forEachCell(edges_[i].seg, [&](std::uint64_t key) {
-      const auto it = std::lower_bound(keys_.begin(), keys_.end(), key);
-      const std::size_t cell = static_cast<std::size_t>(it - keys_.begin());
-      for (std::uint32_t k = start_[cell]; it != keys_.end() && *it == key && k < start_[cell + 1]; ++k)
-      {
-        const std::size_t j = items_[k];
-        if (j > i && stamp_[j] != i + 1)
-        {
-          stamp_[j] = i + 1;
-          visit(j);
-        }
-      }
-    });
-  }
-
-private:
-  static constexpr double kMaxCells = 1073741824.0;  ///< per side: 2^30, so a key fits 64 bits
-
-  std::uint64_t index(double value, double origin) const
-  {
-    const double f = std::floor((value - origin) / cell_);
-    return static_cast<std::uint64_t>(std::clamp(f, 0.0, kMaxCells));
-  }
-
-  template <class Cell>
-  void forEachCell(const Segment& s, Cell cell) const
-  {
-    const std::uint64_t r0 = index(std::min(s.a.y(), s.b.y()), origin_.y());
-    const std::uint64_t r1 = index(std::max(s.a.y(), s.b.y()), origin_.y());
-    const double dy = s.b.y() - s.a.y();
-    const double dx = s.b.x() - s.a.x();
-    for (std::uint64_t r = r0; r <= r1; ++r)
-    {
-      double x0 = std::min(s.a.x(), s.b.x());
-      double x1 = std::max(s.a.x(), s.b.x());
-      if (r0 != r1)
-      {
-        const double ylo = origin_.y() + static_cast<double>(r) * cell_;
-        const double t0 = std::clamp((ylo - s.a.y()) / dy, 0.0, 1.0);
-        const double t1 = std::clamp((ylo + cell_ - s.a.y()) / dy, 0.0, 1.0);
-        x0 = std::min(s.a.x() + t0 * dx, s.a.x() + t1 * dx);
-        x1 = std::max(s.a.x() + t0 * dx, s.a.x() + t1 * dx);
-      }
-      const std::uint64_t c0 = index(x0, origin_.x());
-      const std::uint64_t c1 = index(x1, origin_.x()) + 1;
-      for (std::uint64_t c = c0 == 0 ? 0 : c0 - 1; c <= c1; ++c)
-      {
-        cell((r << 32) | c);
-      }
-    }
-  }
-
-  const std::vector<Edge>& edges_;
-  std::vector<std::size_t> stamp_;
-  std::vector<std::uint64_t> keys_;   ///< occupied cells (row << 32 | column), sorted
-  std::vector<std::uint32_t> start_;  ///< items of keys_[k]: items_[start_[k] .. start_[k + 1])
-  std::vector<std::uint32_t> items_;
-  Vec2 origin_;
-  double cell_ = 1.0;
-};
-
 /// Everything one pass over the edge pairs learns.
 struct Contacts
 {
@@ -313,18 +198,20 @@ void checkOtherRing(const Edge& a, const Edge& b, Contacts& c)
 Contacts findContacts(const std::vector<Ring>& rings, const std::vector<bool>& usable)
 {
   std::vector<Edge> edges;
+  std::vector<Segment> segments;
   for (std::size_t r = 0; r < rings.size(); ++r)
   {
     for (std::size_t i = 0; usable[r] && i < rings[r].size(); ++i)
     {
-      edges.push_back({ r, i, Segment{ rings[r][i], rings[r][(i + 1) % rings[r].size()] } });
+      segments.push_back(Segment{ rings[r][i], rings[r][(i + 1) % rings[r].size()] });
+      edges.push_back({ r, i, segments.back() });
     }
   }
   Contacts c;
   c.bad_edge.assign(rings.size(), -1);
   c.bad_spike.assign(rings.size(), false);
   c.outer_edge.assign(rings.size(), -1);
-  SegmentGrid grid(edges);
+  SegmentBuckets grid(segments);
   bool any_bad = false;
   for (std::size_t i = 0; i < edges.size(); ++i)
   {

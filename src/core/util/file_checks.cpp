@@ -22,7 +22,12 @@ std::string regularFileProblem(const std::string& path)
   struct stat st;
   if (::stat(path.c_str(), &st) != 0)
   {
-    return errno == ENOENT ? "no such file" : std::string("cannot access it: ") + std::strerror(errno);
+    const int error = errno;
+    if (error == ENOENT && ::lstat(path.c_str(), &st) == 0 && S_ISLNK(st.st_mode))
+    {
+      return "a dangling symbolic link (its target does not exist)";
+    }
+    return error == ENOENT ? "no such file" : std::string("cannot access it: ") + std::strerror(error);
   }
   if (S_ISREG(st.st_mode))
   {

@@ -13,7 +13,8 @@ namespace core
 {
 /**
  * @brief Why @p path cannot be read as a regular file, or "" when it can. Follows symbolic
- *        links; never opens the file (so never blocks). Examples: "no such file",
+ *        links; never opens the file (so never blocks). Examples: "no such file" (the one
+ *        answer meaning nothing is there), "a dangling symbolic link (...)",
  *        "not a regular file (a directory)", "not a regular file (a FIFO)",
  *        "cannot access it: Too many levels of symbolic links".
  */

@@ -30,7 +30,12 @@ SegmentBuckets::SegmentBuckets(const std::vector<Segment>& segments) : segments_
   std::vector<std::pair<std::uint64_t, std::uint32_t>> entries;
   for (std::size_t i = 0; i < segments.size(); ++i)
   {
-    forEachCell(segments[i], [&](std::uint64_t key) { entries.emplace_back(key, static_cast<std::uint32_t>(i)); });
+    forEachRowSpan(segments[i], [&](std::uint64_t first, std::uint64_t last) {
+      for (std::uint64_t key = first; key <= last; ++key)
+      {
+        entries.emplace_back(key, static_cast<std::uint32_t>(i));
+      }
+    });
   }
   std::sort(entries.begin(), entries.end());
   items_.reserve(entries.size());

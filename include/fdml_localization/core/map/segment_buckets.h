@@ -33,20 +33,19 @@ public:
   template <class Visit>
   void forEachLaterNeighbour(std::size_t i, Visit visit)
   {
-    forEachCell(segments_[i], [&](std::uint64_t key) {
-      const auto it = std::lower_bound(keys_.begin(), keys_.end(), key);
-      if (it == keys_.end() || *it != key)
+    forEachRowSpan(segments_[i], [&](std::uint64_t first, std::uint64_t last) {
+      // The occupied cells of the span are consecutive in keys_: one search per row.
+      for (auto it = std::lower_bound(keys_.begin(), keys_.end(), first); it != keys_.end() && *it <= last; ++it)
       {
-        return;
-      }
-      const std::size_t cell = static_cast<std::size_t>(it - keys_.begin());
-      for (std::uint32_t k = start_[cell]; k < start_[cell + 1]; ++k)
-      {
-        const std::size_t j = items_[k];
-        if (j > i && stamp_[j] != i + 1)
+        const std::size_t cell = static_cast<std::size_t>(it - keys_.begin());
+        for (std::uint32_t k = start_[cell]; k < start_[cell + 1]; ++k)
         {
-          stamp_[j] = i + 1;
-          visit(j);
+          const std::size_t j = items_[k];
+          if (j > i && stamp_[j] != i + 1)
+          {
+            stamp_[j] = i + 1;
+            visit(j);
+          }
         }
       }
     });
@@ -61,9 +60,10 @@ private:
     return static_cast<std::uint64_t>(std::clamp(f, 0.0, kMaxCells));
   }
 
-  /// Calls cell(key) for every cell (row << 32 | column) segment @p s passes through.
-  template <class Cell>
-  void forEachCell(const Segment& s, Cell cell) const
+  /// Calls span(first, last) with the keys (row << 32 | column) of the first and last cell of
+  /// every row segment @p s passes through.
+  template <class Span>
+  void forEachRowSpan(const Segment& s, Span span) const
   {
     const std::uint64_t r0 = index(std::min(s.a.y(), s.b.y()), origin_.y());
     const std::uint64_t r1 = index(std::max(s.a.y(), s.b.y()), origin_.y());
@@ -83,11 +83,7 @@ private:
         x1 = std::max(s.a.x() + t0 * dx, s.a.x() + t1 * dx);
       }
       const std::uint64_t c0 = index(x0, origin_.x());
-      const std::uint64_t c1 = index(x1, origin_.x()) + 1;
-      for (std::uint64_t c = c0 == 0 ? 0 : c0 - 1; c <= c1; ++c)
-      {
-        cell((r << 32) | c);
-      }
+      span((r << 32) | (c0 == 0 ? 0 : c0 - 1), (r << 32) | (index(x1, origin_.x()) + 1));
     }
   }
 

@@ -1,10 +1,5 @@
 // fdml_localize: global localization from a CSV of range readings on a .poly map.
-//
-//   fdml_localize --map MAP [--resolution N] [--min-inliers K|auto] [--method robust|paper|baseline]
-//                 [--range-tolerance T] [--tolerance EPS] [--threads J] [--engine voxel|adaptive]
-//                 [--cache-dir DIR] [--theta-resolution N] [--max-candidates M] [--max-range R]
-//                 [--verbose] READINGS.csv
-//
+// Usage: kUsage below (fdml_localize --help).
 // READINGS.csv: header "gx,gy,gtheta,d" (optionally ",max_range"), one reading per line
 // [m, rad]; d may be "inf" (no return within max_range). Prints "rank,x,y,theta,inliers,rms"
 // and one candidate per line, best first; exit 0 (also with no candidate), 2 on bad input.

@@ -2,6 +2,7 @@
 // sharing one of its cells), with the verdicts of Boost.Geometry's is_valid (the OGC rules;
 // test_ring_validation.cpp compares the two).
 #include "fdml_localization/core/map/polygon_map.h"
+#include "fdml_localization/core/map/ring_sweep.h"
 #include "fdml_localization/core/map/segment_buckets.h"
 
 #include <algorithm>
@@ -24,44 +25,6 @@ struct Edge
   Segment seg;
 };
 
-/// Sign of the turn a -> b -> c, in extended precision (nearly collinear walls are common in
-/// maps converted from grids, and a wrong sign there would see a crossing that is not).
-int orient(const Vec2& a, const Vec2& b, const Vec2& c)
-{
-  const long double v = (static_cast<long double>(b.x()) - a.x()) * (static_cast<long double>(c.y()) - a.y()) -
-                        (static_cast<long double>(b.y()) - a.y()) * (static_cast<long double>(c.x()) - a.x());
-  return (v > 0.0L) - (v < 0.0L);
-}
-
-bool within(const Vec2& a, const Vec2& b, const Vec2& p)
-{
-  return p.x() >= std::min(a.x(), b.x()) && p.x() <= std::max(a.x(), b.x()) && p.y() >= std::min(a.y(), b.y()) &&
-         p.y() <= std::max(a.y(), b.y());
-}
-
-/// True when the closed segments share a point; their boxes must overlap, whatever the
-/// orientation signs say.
-bool segmentsMeet(const Segment& s, const Segment& t)
-{
-  if (std::max(s.a.x(), s.b.x()) < std::min(t.a.x(), t.b.x()) ||
-      std::max(t.a.x(), t.b.x()) < std::min(s.a.x(), s.b.x()) ||
-      std::max(s.a.y(), s.b.y()) < std::min(t.a.y(), t.b.y()) ||
-      std::max(t.a.y(), t.b.y()) < std::min(s.a.y(), s.b.y()))
-  {
-    return false;
-  }
-  const int o1 = orient(s.a, s.b, t.a);
-  const int o2 = orient(s.a, s.b, t.b);
-  const int o3 = orient(t.a, t.b, s.a);
-  const int o4 = orient(t.a, t.b, s.b);
-  if (o1 != o2 && o3 != o4)
-  {
-    return true;
-  }
-  return (o1 == 0 && within(s.a, s.b, t.a)) || (o2 == 0 && within(s.a, s.b, t.b)) ||
-         (o3 == 0 && within(t.a, t.b, s.a)) || (o4 == 0 && within(t.a, t.b, s.b));
-}
-
 /// How two edges of different rings meet: not at all, at one point (allowed), or more.
 enum class Contact
 {
@@ -72,14 +35,14 @@ enum class Contact
 
 Contact contact(const Segment& s, const Segment& t, Vec2& point)
 {
-  if (!segmentsMeet(s, t))
+  if (!segmentsMeetExact(s, t))
   {
     return Contact::None;
   }
-  const int o1 = orient(s.a, s.b, t.a);
-  const int o2 = orient(s.a, s.b, t.b);
-  const int o3 = orient(t.a, t.b, s.a);
-  const int o4 = orient(t.a, t.b, s.b);
+  const int o1 = orientExact(s.a, s.b, t.a);
+  const int o2 = orientExact(s.a, s.b, t.b);
+  const int o3 = orientExact(t.a, t.b, s.a);
+  const int o4 = orientExact(t.a, t.b, s.b);
   if (o1 * o2 < 0 && o3 * o4 < 0)
   {
     return Contact::Cross;
@@ -97,10 +60,10 @@ Contact contact(const Segment& s, const Segment& t, Vec2& point)
       return Contact::Cross;
     }
   }
-  const std::pair<bool, Vec2> ends[] = { { o1 == 0 && within(s.a, s.b, t.a), t.a },
-                                         { o2 == 0 && within(s.a, s.b, t.b), t.b },
-                                         { o3 == 0 && within(t.a, t.b, s.a), s.a },
-                                         { o4 == 0 && within(t.a, t.b, s.b), s.b } };
+  const std::pair<bool, Vec2> ends[] = { { o1 == 0 && inBox(s.a, s.b, t.a), t.a },
+                                         { o2 == 0 && inBox(s.a, s.b, t.b), t.b },
+                                         { o3 == 0 && inBox(t.a, t.b, s.a), s.a },
+                                         { o4 == 0 && inBox(t.a, t.b, s.b), s.b } };
   for (const auto& end : ends)
   {
     if (end.first)
@@ -139,7 +102,7 @@ std::string ringShapeProblem(const Ring& ring)
   }
   for (std::size_t k = 2; k < ring.size(); ++k)
   {
-    if (orient(ring[0], ring[1], ring[k]) != 0)
+    if (orientExact(ring[0], ring[1], ring[k]) != 0)
     {
       return "";
     }
@@ -163,7 +126,7 @@ void checkSameRing(const std::vector<Ring>& rings, const Edge& a, const Edge& b,
   }
   else
   {
-    problem = segmentsMeet(a.seg, b.seg);
+    problem = segmentsMeetExact(a.seg, b.seg);
   }
   if (problem)
   {
@@ -194,6 +157,15 @@ void checkOtherRing(const Edge& a, const Edge& b, Contacts& c)
   }
 }
 
+Contacts noContacts(std::size_t ring_count)
+{
+  Contacts c;
+  c.bad_edge.assign(ring_count, -1);
+  c.bad_spike.assign(ring_count, false);
+  c.outer_edge.assign(ring_count, -1);
+  return c;
+}
+
 /// One pass over every pair of edges sharing a grid cell (edges of rings listed in @p usable).
 Contacts findContacts(const std::vector<Ring>& rings, const std::vector<bool>& usable)
 {
@@ -207,10 +179,7 @@ Contacts findContacts(const std::vector<Ring>& rings, const std::vector<bool>& u
       edges.push_back({ r, i, segments.back() });
     }
   }
-  Contacts c;
-  c.bad_edge.assign(rings.size(), -1);
-  c.bad_spike.assign(rings.size(), false);
-  c.outer_edge.assign(rings.size(), -1);
+  Contacts c = noContacts(rings.size());
   SegmentBuckets grid(segments);
   bool any_bad = false;
   for (std::size_t i = 0; i < edges.size(); ++i)
@@ -376,7 +345,10 @@ std::vector<RingIssue> validateRings(const std::vector<Ring>& rings)
       issues.push_back({ r, vertex, reason });
     }
   }
-  const Contacts contacts = findContacts(clean, usable);
+  // The sweep certifies the common case (no contacts at all) whatever the shape; the grid
+  // then finds which edges meet, and where rings touch.
+  const Contacts contacts =
+      ringsDisjointBySweep(clean, usable) ? noContacts(rings.size()) : findContacts(clean, usable);
   for (std::size_t r = 0; r < rings.size(); ++r)
   {
     if (contacts.bad_edge[r] >= 0)

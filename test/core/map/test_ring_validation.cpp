@@ -166,6 +166,37 @@ TEST(RingValidation, LargeRingsAreValidatedAndTheirCrossingsFound)
   EXPECT_EQ(crossing.front().ring, 2u);
 }
 
+/// Radii in [5, 10] m at evenly spaced angles: every edge runs beside thousands of others,
+/// the case where Boost (and an edge grid) are quadratic and the sweep line is not.
+Ring zigzagRing(int n)
+{
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> radius(5.0, 10.0);
+  Ring ring;
+  for (int i = 0; i < n; ++i)
+  {
+    const double a = 2.0 * M_PI * i / n;
+    const double r = radius(rng);
+    ring.emplace_back(r * std::cos(a), r * std::sin(a));
+  }
+  return ring;
+}
+
+TEST(RingValidation, DenseZigzagRingsAreValidated)
+{
+  EXPECT_TRUE(validateRings({ zigzagRing(100000) }).empty());
+  // Vertex 5000 of 10,000 moved a quarter turn on, 15 m out: the edge to it from vertex 4999
+  // passes within 8.4 m of the centre, through the zigzags, and crosses them. (Placing a
+  // crossing falls back on the edge grid: quadratic on such a ring, hence the smaller n.)
+  Ring ring = zigzagRing(10000);
+  const double a = 2.0 * M_PI * 5000 / 10000 + M_PI / 2;
+  ring[5000] = Vec2(15.0 * std::cos(a), 15.0 * std::sin(a));
+  const std::vector<RingIssue> issues = validateRings({ ring });
+  ASSERT_FALSE(issues.empty());
+  EXPECT_EQ(issues.front().vertex, 4999u);
+  EXPECT_NE(issues.front().reason.find("crosses itself"), std::string::npos) << issues.front().reason;
+}
+
 TEST(RingValidation, HugeCoordinatesAreRefused)
 {
   const std::vector<RingIssue> issues = validateRings({ { Vec2(0, 0), Vec2(1e19, 0), Vec2(0, 1) } });

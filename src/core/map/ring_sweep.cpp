@@ -106,7 +106,12 @@ bool ringsDisjointBySweep(const std::vector<Ring>& rings, const std::vector<bool
   {
     if (ev.kind == 0)
     {
-      const auto it = status.insert(ev.edge).first;
+      const auto inserted = status.insert(ev.edge);
+      if (!inserted.second)
+      {
+        return false;  // an order contradicted by rounding: let the exact grid decide
+      }
+      const auto it = inserted.first;
       where[ev.edge] = it;
       if ((it != status.begin() && conflict(edges[*std::prev(it)], edges[ev.edge])) ||
           (std::next(it) != status.end() && conflict(edges[*std::next(it)], edges[ev.edge])))

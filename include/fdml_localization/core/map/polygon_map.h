@@ -56,8 +56,9 @@ constexpr double kMaxMapCoordinate = 1e9;
  *        within +-kMaxMapCoordinate, positive area, each ring simple (no edge meets a
  *        non-adjacent edge, no spike), rings meeting each other at most at single points that
  *        do not cut the free space apart, holes inside the outer ring and not inside each
- *        other: the verdicts of Boost.Geometry's is_valid, in O(n log n) typical time (a
- *        uniform grid of edges; a 100,000-vertex ring takes well under a second).
+ *        other: the verdicts of Boost.Geometry's is_valid, in O(n log n) for valid maps
+ *        without touching rings (a sweep line; a 100,000-vertex ring of any shape takes under a
+ *        second), an edge grid locating the contacts otherwise.
  * @return every issue found (empty when valid). Consecutive duplicate vertices and a repeated
  *         closing vertex are not issues (they are removed by PolygonMap).
  */

@@ -1,13 +1,15 @@
 # fdml_localization: the two commands.
 #   make test   install what is missing, build in a private catkin workspace, run every test
 #   make demo   install, build, and run the headless kidnapped-robot demo (RVIZ=1 opens rviz)
-# Other targets: make deps | build | bench | clean
+# Other targets: make deps | build | bench | fuzz | test-asan | clean
+#   make fuzz       the fuzz suite at full size (FUZZ_CASES cases, default 100000; docs/BENCHMARKS.md)
+#   make test-asan  unit tests and the fuzz suite under AddressSanitizer + UBSan (workspace ws-asan/)
 SHELL := /bin/bash
 WS ?= $(CURDIR)/ws
 RVIZ ?= 0
 export WS
 
-.PHONY: all deps build test demo bench clean
+.PHONY: all deps build test demo bench fuzz test-asan clean
 
 all: build
 
@@ -26,5 +28,11 @@ demo: build
 bench: build
 	@bash scripts/bench.sh
 
+fuzz: deps
+	@bash scripts/fuzz.sh
+
+test-asan: deps
+	@bash scripts/test_asan.sh
+
 clean:
-	rm -rf $(WS)
+	rm -rf $(WS) $(CURDIR)/ws-asan

@@ -20,6 +20,7 @@ make_workspace() {
   ws_real="$(cd "$WS" && pwd -P)"
   for entry in "$REPO_DIR"/*; do
     [ "$(cd "$entry" 2>/dev/null && pwd -P)" = "$ws_real" ] && continue
+    case "$(basename "$entry")" in ws | ws-*) continue ;; esac  # other workspaces (ws-asan)
     ln -sfn "$entry" "$pkg/$(basename "$entry")"
   done
   find "$pkg" -maxdepth 1 -xtype l -delete  # entries removed from the checkout

@@ -3,8 +3,9 @@
 #include "fdml_localization/core/map/grid/grid_to_polygon.h"
 #include "fdml_localization/core/map/grid/grid_tolerances.h"
 #include "fdml_localization/core/map/map_io.h"
+#include "fdml_localization/core/util/file_checks.h"
+#include "fdml_localization/io/map_image.h"
 
-#include <stb/stb_image.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -91,31 +92,40 @@ bool readFlag(const YAML::Node& node, const std::string& key, const std::string&
 }
 }  // namespace
 
-MapYaml loadMapYamlFile(const std::string& path)
+namespace
 {
-  YAML::Node root;
+YAML::Node loadYamlRoot(const std::string& path)
+{
+  const std::string problem = core::regularFileProblem(path);
+  if (!problem.empty())
   {
-    std::ifstream in(path);
-    if (!in)
-    {
-      throw MapError(path, 0, "cannot open the map YAML file");
-    }
-    try
-    {
-      root = YAML::Load(in);
-    }
-    catch (const YAML::ParserException& e)
-    {
-      throw MapError(path, e.mark.is_null() ? 0 : e.mark.line + 1, "YAML syntax error: " + e.msg);
-    }
+    throw MapError(path, 0, "cannot open the map YAML file: " + problem);
+  }
+  std::ifstream in(path);
+  if (!in)
+  {
+    throw MapError(path, 0, "cannot open the map YAML file");
+  }
+  YAML::Node root;
+  try
+  {
+    root = YAML::Load(in);
+  }
+  catch (const YAML::ParserException& e)
+  {
+    throw MapError(path, e.mark.is_null() ? 0 : e.mark.line + 1, "YAML syntax error: " + e.msg);
   }
   if (!root.IsMap())
   {
     throw MapError(path, 0, "not a map_server YAML file (expected a mapping of keys)");
   }
-  MapYaml meta;
+  return root;
+}
+
+void readImageAndGeometry(const YAML::Node& root, const std::string& path, MapYaml& meta)
+{
   const YAML::Node image = requireKey(root, "image", path);
-  if (!image.IsScalar() || image.Scalar().empty())
+  if (!image.IsScalar() || image.Scalar().empty() || image.Scalar().find('\0') != std::string::npos)
   {
     throw MapError(path, lineOf(image), "key 'image' must be a file name");
   }
@@ -137,7 +147,10 @@ MapYaml loadMapYamlFile(const std::string& path)
   }
   meta.origin = Pose2(readNumber(origin[0], "origin", path), readNumber(origin[1], "origin", path),
                       readNumber(origin[2], "origin", path));
+}
 
+void readThresholdsAndMode(const YAML::Node& root, const std::string& path, MapYaml& meta)
+{
   const YAML::Node occ = requireKey(root, "occupied_thresh", path);
   meta.occupied_thresh = readNumber(occ, "occupied_thresh", path);
   const YAML::Node free = requireKey(root, "free_thresh", path);
@@ -164,29 +177,24 @@ MapYaml loadMapYamlFile(const std::string& path)
       throw MapError(path, lineOf(mode), std::string("key 'mode': ") + e.what());
     }
   }
+}
+}  // namespace
+
+MapYaml loadMapYamlFile(const std::string& path)
+{
+  const YAML::Node root = loadYamlRoot(path);
+  MapYaml meta;
+  readImageAndGeometry(root, path, meta);
+  readThresholdsAndMode(root, path, meta);
   return meta;
 }
 
 OccupancyGrid loadOccupancyGridYaml(const std::string& yaml_path)
 {
   const MapYaml meta = loadMapYamlFile(yaml_path);
-  if (!std::filesystem::exists(meta.image_path))
-  {
-    throw MapError(meta.image_path, 0, "image file not found (named by '" + meta.image + "' in " + yaml_path + ")");
-  }
-  int width = 0;
-  int height = 0;
-  int channels = 0;
-  std::unique_ptr<stbi_uc, void (*)(void*)> pixels(stbi_load(meta.image_path.c_str(), &width, &height, &channels, 0),
-                                                   stbi_image_free);
-  if (!pixels)
-  {
-    const char* why = stbi_failure_reason();
-    throw MapError(meta.image_path, 0,
-                   std::string("cannot decode the image (") + (why ? why : "unknown reason") +
-                       "; readable: binary PGM, PNG, BMP, JPEG, TGA, GIF), named by " + yaml_path);
-  }
-  return pixelsToGrid(pixels.get(), width, height, channels, meta);
+  ImageInfo info;
+  const std::vector<std::uint8_t> pixels = loadImagePixels(meta.image_path, info, yaml_path);
+  return pixelsToGrid(pixels.data(), info.width, info.height, info.channels, meta);
 }
 
 namespace

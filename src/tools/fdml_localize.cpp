@@ -1,20 +1,14 @@
 // fdml_localize: global localization from a CSV of range readings on a map (.poly, or a
 // map_server .yaml grid; a map from a grid gets the grid tolerances, core::withGridTolerances).
-//
-//   fdml_localize --map MAP [--resolution N] [--min-inliers K|auto] [--method robust|paper|baseline]
-//                 [--range-tolerance T] [--tolerance EPS] [--threads J] [--engine voxel|adaptive]
-//                 [--cache-dir DIR] [--theta-resolution N] [--max-candidates M] [--max-range R]
-//                 [--verbose] [--no-return constraint|weak|drop] READINGS.csv
-//
-// READINGS.csv: header "gx,gy,gtheta,d" (optionally ",max_range", then optionally ",fov": the
-// sensor's full field of view [deg], 0 = a ray), one reading per line
-// [m, rad]; d may be "inf" (no return within max_range). Prints "rank,x,y,theta,inliers,rms"
+// Usage: kUsage below (fdml_localize --help). READINGS.csv: see readings_csv.h. Prints "rank,x,y,theta,inliers,rms"
 // and one candidate per line, best first; exit 0 (also with no candidate), 2 on bad input.
-#include "fdml_localization/core/geometry/cone_cast.h"
+#include "readings_csv.h"
+
 #include "fdml_localization/core/localization/localizer.h"
 #include "fdml_localization/core/map/grid/grid_tolerances.h"
-#include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/core/localization/ranking.h"
+#include "fdml_localization/core/localization/voxel/table_cache.h"
+#include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/core/util/text_parsing.h"
 #include "fdml_localization/io/map_files.h"
 
@@ -24,6 +18,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -32,132 +27,19 @@
 namespace
 {
 namespace core = fdml_localization::core;
+
 namespace io = fdml_localization::io;
+namespace tools = fdml_localization::tools;
 
 /// Bad input: reported on stderr, exit code 2.
-struct UsageError : std::runtime_error
-{
-  using std::runtime_error::runtime_error;
-};
+using UsageError = tools::InputError;
 
 const char* kUsage = "usage: fdml_localize --map MAP.poly|MAP.yaml [--resolution N] [--min-inliers K|auto]\n"
                      "                     [--method robust|paper|baseline] [--range-tolerance T] [--tolerance EPS]\n"
                      "                     [--threads J] [--engine voxel|adaptive] [--cache-dir DIR]\n"
                      "                     [--theta-resolution N] [--max-candidates M] [--max-range R] [--verbose]\n"
-                     "                     [--no-return constraint|weak|drop]\n"
-                     "                     READINGS.csv\n";
-
-std::vector<std::string> splitCsv(const std::string& line)
-{
-  std::vector<std::string> fields;
-  std::stringstream in(line);
-  std::string field;
-  while (std::getline(in, field, ','))
-  {
-    fields.push_back(core::trim(field));
-  }
-  if (!line.empty() && line.back() == ',')
-  {
-    fields.push_back("");
-  }
-  return fields;
-}
-
-/// The readings header: "gx,gy,gtheta,d", then optionally ",max_range", then optionally ",fov".
-void parseHeader(const std::string& header, const std::string& where, bool* has_max_range, bool* has_fov)
-{
-  const std::string base = "gx,gy,gtheta,d";
-  for (const bool max_range : { false, true })
-  {
-    for (const bool fov : { false, true })
-    {
-      if (header == base + (max_range ? ",max_range" : "") + (fov ? ",fov" : ""))
-      {
-        *has_max_range = max_range;
-        *has_fov = fov;
-        return;
-      }
-    }
-  }
-  throw UsageError(where +
-                   ": expected the header 'gx,gy,gtheta,d' (optionally ',max_range', then optionally ',fov'), got '" +
-                   header + "'");
-}
-
-/// The fov column: the sensor's full field of view [deg] in [0, 180] (0 = a ray); the reading's
-/// cone half-angle [rad].
-double parseFovColumn(const std::string& field, const std::string& where)
-{
-  const double degrees = core::parseNumber(field, where + ": fov", true);
-  if (!(degrees >= 0.0 && degrees <= 180.0))
-  {
-    throw UsageError(where + ": fov must be in [0, 180] degrees (the full field of view; 0 = a ray), got " + field);
-  }
-  return std::min(0.5 * degrees * core::kPi / 180.0, core::kMaxConeHalfAngle);
-}
-
-std::vector<core::Reading> readCsv(const std::string& path, double default_max_range)
-{
-  std::ifstream in(path);
-  if (!in)
-  {
-    throw UsageError(path + ": cannot open");
-  }
-  std::string line;
-  int line_no = 0;
-  bool have_header = false;
-  bool has_max_range = false;
-  bool has_fov = false;
-  std::vector<core::Reading> readings;
-  while (std::getline(in, line))
-  {
-    ++line_no;
-    const std::string t = core::trim(line);
-    if (t.empty() || t[0] == '#')
-    {
-      continue;
-    }
-    const std::string where = path + ":" + std::to_string(line_no);
-    const std::vector<std::string> fields = splitCsv(t);
-    if (!have_header)
-    {
-      parseHeader(t, where, &has_max_range, &has_fov);
-      have_header = true;
-      continue;
-    }
-    const std::size_t expected = 4 + (has_max_range ? 1 : 0) + (has_fov ? 1 : 0);
-    if (fields.size() != expected)
-    {
-      throw UsageError(where + ": expected " + std::to_string(expected) + " fields, got " +
-                       std::to_string(fields.size()));
-    }
-    core::Reading r;
-    r.offset.x = core::parseNumber(fields[0], where + ": gx", true);
-    r.offset.y = core::parseNumber(fields[1], where + ": gy", true);
-    r.offset.theta = core::parseNumber(fields[2], where + ": gtheta", true);
-    r.range = core::parseNumber(fields[3], where + ": d", true);
-    r.max_range = has_max_range ? core::parseNumber(fields[4], where + ": max_range", true) : default_max_range;
-    r.half_angle = has_fov ? parseFovColumn(fields.back(), where) : 0.0;
-    if (!std::isfinite(r.offset.x) || !std::isfinite(r.offset.y) || !std::isfinite(r.offset.theta))
-    {
-      throw UsageError(where + ": gx, gy and gtheta must be finite");
-    }
-    if (std::isnan(r.range) || r.range < 0.0)
-    {
-      throw UsageError(where + ": d must be >= 0 or inf, got " + fields[3]);
-    }
-    if (std::isinf(r.range) && !std::isfinite(r.max_range))
-    {
-      throw UsageError(where + ": d = inf needs a finite max range (--max-range or a max_range column)");
-    }
-    readings.push_back(r);
-  }
-  if (!have_header)
-  {
-    throw UsageError(path + ": empty file (expected the header 'gx,gy,gtheta,d')");
-  }
-  return readings;
-}
+                     "                     [--no-return constraint|weak|drop] READINGS.csv\n"
+                     "READINGS.csv: header gx,gy,gtheta,d[,max_range][,fov] (fov: full field of view [deg])\n";
 
 struct Arguments
 {
@@ -168,6 +50,69 @@ struct Arguments
   bool verbose = false;
   core::ExplicitTolerances set;  ///< tolerances given on the command line (kept on a grid map)
 };
+
+/// Applies one option flag that takes a value; false when @p flag is not one of them.
+bool applyValueFlag(const std::string& flag, const std::function<std::string()>& value, Arguments& args)
+{
+  core::LocalizerOptions& o = args.options;
+  if (flag == "--map")
+  {
+    args.map = value();
+  }
+  else if (flag == "--resolution" || flag == "--theta-resolution" || flag == "--threads" || flag == "--max-candidates")
+  {
+    const int n = core::parseInteger(value(), flag);
+    int& target = flag == "--resolution"       ? o.resolution :
+                  flag == "--theta-resolution" ? o.theta_resolution :
+                  flag == "--threads"          ? o.threads :
+                                                 o.max_candidates;
+    target = n;
+  }
+  else if (flag == "--min-inliers")
+  {
+    const std::string v = value();
+    o.min_inliers = v == "auto" ? 0 : core::parseInteger(v, flag);
+    if (v != "auto" && o.min_inliers < 3)
+    {
+      throw UsageError("--min-inliers " + v + ": must be 'auto' or an integer >= 3");
+    }
+  }
+  else if (flag == "--method")
+  {
+    o.method = core::parseMethod(value());
+  }
+  else if (flag == "--engine")
+  {
+    o.engine = core::parseEngine(value());
+  }
+  else if (flag == "--no-return")
+  {
+    o.no_return = core::parseNoReturn(value());
+  }
+  else if (flag == "--range-tolerance")
+  {
+    o.range_tolerance = core::parseNumber(value(), flag);
+    args.set.range_tolerance = true;
+  }
+  else if (flag == "--tolerance")
+  {
+    o.agreement_tolerance = core::parseNumber(value(), flag);
+    args.set.agreement_tolerance = true;
+  }
+  else if (flag == "--cache-dir")
+  {
+    o.cache_dir = value();
+  }
+  else if (flag == "--max-range")
+  {
+    args.max_range = core::parseNumber(value(), flag, true);
+  }
+  else
+  {
+    return false;
+  }
+  return true;
+}
 
 Arguments parseArguments(int argc, char** argv)
 {
@@ -182,66 +127,11 @@ Arguments parseArguments(int argc, char** argv)
       }
       return argv[++i];
     };
-    if (flag == "--map")
+    if (applyValueFlag(flag, value, args))
     {
-      args.map = value();
+      continue;
     }
-    else if (flag == "--resolution")
-    {
-      args.options.resolution = core::parseInteger(value(), flag);
-    }
-    else if (flag == "--theta-resolution")
-    {
-      args.options.theta_resolution = core::parseInteger(value(), flag);
-    }
-    else if (flag == "--min-inliers")
-    {
-      const std::string v = value();
-      args.options.min_inliers = v == "auto" ? 0 : core::parseInteger(v, flag);
-      if (v != "auto" && args.options.min_inliers < 3)
-      {
-        throw UsageError("--min-inliers " + v + ": must be 'auto' or an integer >= 3");
-      }
-    }
-    else if (flag == "--method")
-    {
-      args.options.method = core::parseMethod(value());
-    }
-    else if (flag == "--engine")
-    {
-      args.options.engine = core::parseEngine(value());
-    }
-    else if (flag == "--no-return")
-    {
-      args.options.no_return = core::parseNoReturn(value());
-    }
-    else if (flag == "--range-tolerance")
-    {
-      args.options.range_tolerance = core::parseNumber(value(), flag);
-      args.set.range_tolerance = true;
-    }
-    else if (flag == "--tolerance")
-    {
-      args.options.agreement_tolerance = core::parseNumber(value(), flag);
-      args.set.agreement_tolerance = true;
-    }
-    else if (flag == "--threads")
-    {
-      args.options.threads = core::parseInteger(value(), flag);
-    }
-    else if (flag == "--cache-dir")
-    {
-      args.options.cache_dir = value();
-    }
-    else if (flag == "--max-candidates")
-    {
-      args.options.max_candidates = core::parseInteger(value(), flag);
-    }
-    else if (flag == "--max-range")
-    {
-      args.max_range = core::parseNumber(value(), flag, true);
-    }
-    else if (flag == "--verbose")
+    if (flag == "--verbose")
     {
       args.verbose = true;
     }
@@ -332,11 +222,17 @@ int main(int argc, char** argv)
       }
       throw UsageError(text);
     }
-    const std::vector<core::Reading> readings = readCsv(args.csv, args.max_range);
+    const tools::CsvReadings csv = tools::readReadingsCsv(args.csv, args.max_range);
+    tools::validateCsvReadings(csv, args.csv, args.options);
     io::MapFile file = io::readMapFile(args.map);
     auto map = std::make_shared<const core::MapRayCaster>(std::move(file.map));
     core::Localizer localizer(map, core::withGridTolerances(args.options, file.cell_size, args.set));
-    const core::Result result = localizer.localize(readings);
+    const core::Result result = localizer.localize(csv.readings);
+    const std::string cache_warning = core::tableCacheWarning(localizer);
+    if (!cache_warning.empty())
+    {
+      std::cerr << "fdml_localize: warning: distance-table cache: " << cache_warning << "\n";
+    }
     printResult(result);
     if (args.verbose)
     {

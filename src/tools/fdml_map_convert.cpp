@@ -14,6 +14,7 @@
 #include "fdml_localization/io/map_files.h"
 
 #include <cmath>
+#include <functional>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
@@ -33,7 +34,8 @@ const char* kUsage = "usage: fdml_map_convert MAP.yaml OUT.poly [--tolerance M] 
                      "largest)\n"
                      "  --occupied-threshold N   cells with value >= N (1..100) are walls (default 50); unknown is a "
                      "wall\n"
-                     "  --no-preview             do not write OUT.png\n";
+                     "  --no-preview             do not write OUT.png\n"
+                     "  --help                   print this help and exit\n";
 
 struct Arguments
 {
@@ -42,6 +44,57 @@ struct Arguments
   core::GridConversionOptions options;
   bool preview = true;
 };
+
+/// Applies one option flag; false when @p arg is not one of them.
+bool applyFlag(const std::string& arg, const std::function<std::string()>& value, Arguments& args)
+{
+  if (arg == "--tolerance")
+  {
+    args.options.tolerance = core::parseNumber(value(), arg);
+    if (args.options.tolerance <= 0.0)
+    {
+      throw std::invalid_argument("--tolerance must be > 0 [m]");
+    }
+  }
+  else if (arg == "--min-area")
+  {
+    args.options.min_area = core::parseNumber(value(), arg);
+    if (args.options.min_area < 0.0)
+    {
+      throw std::invalid_argument("--min-area must be >= 0 [m^2]");
+    }
+  }
+  else if (arg == "--seed-point")
+  {
+    const std::string text = value();
+    const std::size_t comma = text.find(',');
+    if (comma == std::string::npos)
+    {
+      throw std::invalid_argument("--seed-point: expected X,Y, got '" + text + "'");
+    }
+    args.options.use_seed = true;
+    args.options.seed_point =
+        core::Vec2(core::parseNumber(text.substr(0, comma), arg), core::parseNumber(text.substr(comma + 1), arg));
+  }
+  else if (arg == "--occupied-threshold")
+  {
+    const double n = core::parseNumber(value(), arg);
+    if (n != std::floor(n) || n < 1 || n > 100)
+    {
+      throw std::invalid_argument("--occupied-threshold must be an integer in [1, 100]");
+    }
+    args.options.occupied_threshold = static_cast<int>(n);
+  }
+  else if (arg == "--no-preview")
+  {
+    args.preview = false;
+  }
+  else
+  {
+    return false;
+  }
+  return true;
+}
 
 Arguments parseArguments(int argc, char** argv)
 {
@@ -57,70 +110,24 @@ Arguments parseArguments(int argc, char** argv)
       }
       return argv[++i];
     };
-    if (arg == "--tolerance")
-    {
-      args.options.tolerance = core::parseNumber(value(), arg);
-      if (args.options.tolerance <= 0.0)
-      {
-        throw std::invalid_argument("--tolerance must be > 0 [m]");
-      }
-    }
-    else if (arg == "--min-area")
-    {
-      args.options.min_area = core::parseNumber(value(), arg);
-      if (args.options.min_area < 0.0)
-      {
-        throw std::invalid_argument("--min-area must be >= 0 [m^2]");
-      }
-    }
-    else if (arg == "--seed-point")
-    {
-      const std::string text = value();
-      const std::size_t comma = text.find(',');
-      if (comma == std::string::npos)
-      {
-        throw std::invalid_argument("--seed-point: expected X,Y, got '" + text + "'");
-      }
-      args.options.use_seed = true;
-      args.options.seed_point =
-          core::Vec2(core::parseNumber(text.substr(0, comma), arg), core::parseNumber(text.substr(comma + 1), arg));
-    }
-    else if (arg == "--occupied-threshold")
-    {
-      const double n = core::parseNumber(value(), arg);
-      if (n != std::floor(n) || n < 1 || n > 100)
-      {
-        throw std::invalid_argument("--occupied-threshold must be an integer in [1, 100]");
-      }
-      args.options.occupied_threshold = static_cast<int>(n);
-    }
-    else if (arg == "--no-preview")
-    {
-      args.preview = false;
-    }
-    else if (arg == "-h" || arg == "--help")
+    if (arg == "-h" || arg == "--help")
     {
       std::cout << kUsage;
       std::exit(0);
     }
-    else if (!arg.empty() && arg[0] == '-')
+    if (applyFlag(arg, value, args))
+    {
+      continue;
+    }
+    if (!arg.empty() && arg[0] == '-')
     {
       throw std::invalid_argument("unknown option " + arg);
     }
-    else if (positional == 0)
-    {
-      args.input = arg;
-      ++positional;
-    }
-    else if (positional == 1)
-    {
-      args.output = arg;
-      ++positional;
-    }
-    else
+    if (positional >= 2)
     {
       throw std::invalid_argument("too many arguments ('" + arg + "')");
     }
+    (positional++ == 0 ? args.input : args.output) = arg;
   }
   if (positional != 2)
   {

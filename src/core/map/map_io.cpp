@@ -1,8 +1,10 @@
 #include "fdml_localization/core/map/map_io.h"
 
+#include "fdml_localization/core/util/file_checks.h"
 #include "fdml_localization/core/util/text_parsing.h"
 
 #include <cerrno>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -40,6 +42,11 @@ bool parseVertex(const std::string& text, Vec2& out, std::string& reason)
       reason = "non-finite coordinate in \"" + text + "\"";
       return false;
     }
+    if (std::abs(value) > kMaxMapCoordinate)
+    {
+      reason = "coordinate beyond +-1e9 m (the largest a map may use) in \"" + text + "\"";
+      return false;
+    }
     p = end;
   }
   while (*p == ' ' || *p == '\t' || *p == '\r')
@@ -65,6 +72,10 @@ PolygonMap parsePoly(std::istream& in, const std::string& source)
   while (std::getline(in, raw))
   {
     ++line_no;
+    if (raw.find('\0') != std::string::npos)
+    {
+      throw MapError(source, line_no, "NUL byte in the line (not a text file?)");
+    }
     const std::size_t hash = raw.find('#');
     const bool comment_only = hash != std::string::npos && trim(raw.substr(0, hash)).empty();
     const std::string text = trim(hash == std::string::npos ? raw : raw.substr(0, hash));
@@ -110,6 +121,11 @@ PolygonMap parsePoly(std::istream& in, const std::string& source)
 
 PolygonMap loadPolyFile(const std::string& path)
 {
+  const std::string problem = regularFileProblem(path);
+  if (!problem.empty())
+  {
+    throw MapError(path, 0, "cannot open map file: " + problem);
+  }
   std::ifstream in(path);
   if (!in)
   {

@@ -1,6 +1,14 @@
 #include "fdml_localization/core/localization/voxel/table_cache.h"
 
+#include "fdml_localization/core/localization/localizer.h"
+#include "fdml_localization/core/localization/voxel/voxel_engine.h"
+#include "fdml_localization/core/util/file_checks.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
+
+#include <cerrno>
 
 #include <atomic>
 #include <cstdio>
@@ -127,8 +135,9 @@ bool saveTable(const std::string& path, std::uint64_t map_hash, const DistanceTa
     out.close();
     if (!out)
     {
+      const std::string why = std::strerror(errno);
       std::filesystem::remove(tmp, ec);
-      setError(error, "cannot write " + tmp);
+      setError(error, "cannot write " + tmp + ": " + why);
       return false;
     }
   }
@@ -142,22 +151,70 @@ bool saveTable(const std::string& path, std::uint64_t map_hash, const DistanceTa
   return true;
 }
 
+namespace
+{
+/// Reads at most @p limit bytes of a regular file opened non-blocking (a FIFO, a device or a
+/// directory is refused before it is opened). Returns false with the reason in @p error.
+bool readRegularFile(const std::string& path, std::size_t limit, std::vector<char>& bytes, std::string& error)
+{
+  const std::string problem = regularFileProblem(path);
+  if (!problem.empty())
+  {
+    error = path + ": " + problem;
+    return false;
+  }
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  struct stat st;
+  if (fd < 0 || ::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode))
+  {
+    error = path + ": cannot open: " + (fd < 0 ? std::strerror(errno) : "not a regular file");
+    if (fd >= 0)
+    {
+      ::close(fd);
+    }
+    return false;
+  }
+  bytes.resize(limit);
+  std::size_t got = 0;
+  while (got < limit)
+  {
+    const ssize_t n = ::read(fd, bytes.data() + got, limit - got);
+    if (n < 0 && errno == EINTR)
+    {
+      continue;
+    }
+    if (n <= 0)
+    {
+      break;
+    }
+    got += static_cast<std::size_t>(n);
+  }
+  ::close(fd);
+  bytes.resize(got);
+  return true;
+}
+}  // namespace
+
 bool loadTable(const std::string& path, std::uint64_t map_hash, const GridSpec& spec, DistanceTable& table,
                std::string* error)
 {
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
+  const Header expected = makeHeader(map_hash, spec);
+  const std::size_t value_bytes = spec.voxelCount() * sizeof(float);
+  const std::size_t file_bytes = sizeof(Header) + value_bytes + sizeof(std::uint64_t);
+  std::vector<char> bytes;
+  std::string why;
+  if (!readRegularFile(path, file_bytes + 1, bytes, why))
   {
-    setError(error, path + ": cannot open");
+    setError(error, why);
     return false;
   }
-  const Header expected = makeHeader(map_hash, spec);
   Header header;
-  if (!in.read(reinterpret_cast<char*>(&header), sizeof(header)))
+  if (bytes.size() < sizeof(header))
   {
     setError(error, path + ": truncated header");
     return false;
   }
+  std::memcpy(&header, bytes.data(), sizeof(header));
   if (std::memcmp(header.magic, kMagic, sizeof(kMagic)) != 0)
   {
     setError(error, path + ": not a distance-table file");
@@ -174,21 +231,22 @@ bool loadTable(const std::string& path, std::uint64_t map_hash, const GridSpec& 
     setError(error, path + ": written for another map or grid");
     return false;
   }
-  std::vector<float> values(spec.voxelCount());
-  std::uint64_t stored = 0;
-  if (!in.read(reinterpret_cast<char*>(values.data()), static_cast<std::streamsize>(values.size() * sizeof(float))) ||
-      !in.read(reinterpret_cast<char*>(&stored), sizeof(stored)))
+  if (bytes.size() < file_bytes)
   {
     setError(error, path + ": truncated data");
     return false;
   }
-  if (in.peek() != std::ifstream::traits_type::eof())
+  if (bytes.size() > file_bytes)
   {
     setError(error, path + ": trailing bytes after the checksum");
     return false;
   }
+  std::vector<float> values(spec.voxelCount());
+  std::uint64_t stored = 0;
+  std::memcpy(values.data(), bytes.data() + sizeof(header), value_bytes);
+  std::memcpy(&stored, bytes.data() + sizeof(header) + value_bytes, sizeof(stored));
   std::uint64_t sum = checksum64(&header, sizeof(header));
-  sum = checksum64(values.data(), values.size() * sizeof(float), sum);
+  sum = checksum64(values.data(), value_bytes, sum);
   if (sum != stored)
   {
     setError(error, path + ": checksum mismatch (corrupt file)");
@@ -202,40 +260,52 @@ DistanceTable loadOrBuildTable(const MapRayCaster& map, const GridSpec& spec, co
                                TableSource* source, std::string* reason)
 {
   setError(reason, "");
+  TableSource unused;
+  source = source ? source : &unused;
+  *source = TableSource::Built;
   if (cache_dir.empty())
   {
-    if (source)
-    {
-      *source = TableSource::Built;
-    }
     return DistanceTable::build(map, spec, threads);
   }
   const std::uint64_t map_hash = map.map().hash();
   const std::string path = tableCachePath(cache_dir, map_hash, spec);
-  const bool existed = std::filesystem::exists(path);
+  const std::string problem = regularFileProblem(path);
   DistanceTable table;
   std::string why;
-  if (existed && loadTable(path, map_hash, spec, table, &why))
+  if (problem.empty() && loadTable(path, map_hash, spec, table, &why))
   {
-    if (source)
-    {
-      *source = TableSource::Loaded;
-    }
+    *source = TableSource::Loaded;
     return table;
   }
-  setError(reason, why);
   table = DistanceTable::build(map, spec, threads);
+  if (problem == "no such file")
+  {
+    *source = TableSource::BuiltAndSaved;
+  }
+  else if (problem.empty())
+  {
+    *source = TableSource::Rebuilt;  // a regular file, rejected: rewritten below
+    why = "cache file rejected (" + why + "); tables rebuilt";
+  }
+  else
+  {
+    setError(reason, "cache file " + path + " not used: " + problem + "; tables built without the cache");
+    return table;
+  }
   std::string save_error;
-  saveTable(path, map_hash, table, &save_error);
-  if (source)
+  if (!saveTable(path, map_hash, table, &save_error))
   {
-    *source = existed ? TableSource::Rebuilt : TableSource::BuiltAndSaved;
+    *source = TableSource::Built;
+    why += std::string(why.empty() ? "" : "; ") + "cache not saved: " + save_error;
   }
-  if (!save_error.empty() && reason)
-  {
-    *reason += (reason->empty() ? "" : "; ") + save_error;
-  }
+  setError(reason, why);
   return table;
+}
+
+std::string tableCacheWarning(Localizer& localizer)
+{
+  const auto* voxel = dynamic_cast<const VoxelEngine*>(&localizer.engine());
+  return voxel ? voxel->cacheMessage() : std::string();
 }
 
 }  // namespace core

@@ -49,11 +49,21 @@ enum class TableSource
 
 /**
  * @brief The table of (map, grid): from the cache in @p cache_dir when valid, else built
- *        (and saved there when @p cache_dir is not empty).
- * @param reason when not null, receives why a cache file was rejected (empty otherwise)
+ *        (and saved there when @p cache_dir is not empty). A cache problem never stops the
+ *        build: a corrupt, truncated or stale file is rebuilt and rewritten; a path that is not
+ *        a regular file (a directory, a FIFO, a symbolic-link loop, a name too long) is never
+ *        opened and never replaced; a file that cannot be saved is skipped.
+ * @param reason when not null, receives the warning to show once (naming the cache path and
+ *        the reason: a file rejected, not used or not saved); empty when the cache just worked
  */
 DistanceTable loadOrBuildTable(const MapRayCaster& map, const GridSpec& spec, const std::string& cache_dir, int threads,
                                TableSource* source = nullptr, std::string* reason = nullptr);
+
+class Localizer;
+
+/// The cache warning of @p localizer's voxel engine (see loadOrBuildTable()), empty when
+/// there is none or the engine keeps no cache. Tools and the node show it once.
+std::string tableCacheWarning(Localizer& localizer);
 
 /// 64-bit checksum of a byte range (word-wise multiply-xorshift; not cryptographic).
 std::uint64_t checksum64(const void* data, std::size_t bytes, std::uint64_t seed = 0);

@@ -85,20 +85,18 @@ Pose2 GridSpec::centre(std::size_t v) const
 
 bool GridSpec::locate(const Pose2& pose, int& ix, int& iy, int& it) const
 {
-  const double fx = std::floor((pose.x - origin_x) / cell);
-  const double fy = std::floor((pose.y - origin_y) / cell);
-  if (!(fx >= 0.0 && fx < nx && fy >= 0.0 && fy < ny))
+  int fx = 0;
+  int fy = 0;
+  int ft = 0;
+  if (!floorIndex((pose.x - origin_x) / cell, 2.0 * nx + 2.0, fx) ||
+      !floorIndex((pose.y - origin_y) / cell, 2.0 * ny + 2.0, fy) || fx < 0 || fx >= nx || fy < 0 || fy >= ny ||
+      !floorIndex((wrapAngle(pose.theta) + kPi) / thetaStep(), 2.0 * nt + 2.0, ft))
   {
     return false;
   }
-  ix = static_cast<int>(fx);
-  iy = static_cast<int>(fy);
-  const double ft = std::floor((wrapAngle(pose.theta) + kPi) / thetaStep());
-  it = static_cast<int>(ft) % nt;
-  if (it < 0)
-  {
-    it += nt;
-  }
+  ix = fx;
+  iy = fy;
+  it = ((ft % nt) + nt) % nt;
   return true;
 }
 

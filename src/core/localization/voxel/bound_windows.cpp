@@ -37,28 +37,12 @@ void slidingPeriodic(const std::vector<float>& in, int m, Better better, std::ve
     }
   }
 }
-}  // namespace
 
-BoundWindows::BoundWindows(CellBounds cells) : cells_(std::move(cells))
-{}
-
-void BoundWindows::require(Kind kind, int m)
+/// Per padded cell column, the min (or max) over theta cells t .. t + m - 1.
+std::vector<float> alongTheta(const std::vector<float>& src, int nt, int m, bool theta_min)
 {
-  const auto key = std::make_pair(static_cast<int>(kind), m);
-  if (arrays_.count(key) != 0)
-  {
-    return;
-  }
-  const GridSpec& spec = cells_.spec();
-  const int pnx = cells_.paddedNx();
-  const int pny = cells_.paddedNy();
-  const int nt = spec.nt;
-  const bool lower = kind == Kind::Lower;
-  const bool theta_min = kind != Kind::UpperMax;
-  const std::vector<float>& src = lower ? cells_.lower() : cells_.upper();
-  // Along theta first, per padded cell column.
   std::vector<float> along(src.size());
-  const std::size_t pslice = static_cast<std::size_t>(pnx) * pny;
+  const std::size_t pslice = src.size() / static_cast<std::size_t>(nt);
 #pragma omp parallel
   {
     std::vector<float> in(nt);
@@ -86,10 +70,17 @@ void BoundWindows::require(Kind kind, int m)
       }
     }
   }
-  // Then 2 x 2 in position: window (wx, wy) = padded cells (wx .. wx + 1, wy .. wy + 1).
+  return along;
+}
+
+/// Min (lower) or max over 2 x 2 padded cells: window (wx, wy) = cells (wx .. wx + 1, wy .. wy + 1).
+std::vector<float> positionWindows(const std::vector<float>& along, const GridSpec& spec, bool lower)
+{
+  const int pnx = spec.nx + 1;
+  const std::size_t pslice = static_cast<std::size_t>(pnx) * (spec.ny + 1);
   std::vector<float> result(spec.voxelCount());
 #pragma omp parallel for schedule(static)
-  for (int t = 0; t < nt; ++t)
+  for (int t = 0; t < spec.nt; ++t)
   {
     for (int wy = 0; wy < spec.ny; ++wy)
     {
@@ -103,7 +94,23 @@ void BoundWindows::require(Kind kind, int m)
       }
     }
   }
-  arrays_.emplace(key, std::move(result));
+  return result;
+}
+}  // namespace
+
+BoundWindows::BoundWindows(CellBounds cells) : cells_(std::move(cells))
+{}
+
+void BoundWindows::require(Kind kind, int m)
+{
+  const auto key = std::make_pair(static_cast<int>(kind), m);
+  if (arrays_.count(key) == 0)
+  {
+    const bool lower = kind == Kind::Lower;
+    const std::vector<float> along =
+        alongTheta(lower ? cells_.lower() : cells_.upper(), cells_.spec().nt, m, kind != Kind::UpperMax);
+    arrays_.emplace(key, positionWindows(along, cells_.spec(), lower));
+  }
 }
 
 const std::vector<float>& BoundWindows::get(Kind kind, int m) const

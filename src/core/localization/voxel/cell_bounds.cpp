@@ -171,6 +171,74 @@ bool freePieces(const MapRayCaster& map, const Box2& box, double margin, std::ve
   return splitPieces(map, box, margin, kSplitDepth, pieces);
 }
 
+namespace
+{
+/// The free pieces of a position box and, per piece vertex, the segment hit at every sample
+/// heading (from the table's samples when the piece is the whole box, else cast).
+struct Column
+{
+  bool simple = false;
+  std::vector<std::vector<Vec2>> pieces;
+  std::vector<std::vector<int>> vertex_hits;
+};
+
+void columnPieces(const MapRayCaster& map, const GridSpec& spec, const std::vector<int>& hits, int jx, int jy,
+                  Column& column)
+{
+  Box2 box;
+  box.extend(Vec2(spec.centreX(jx), spec.centreY(jy)));
+  box.extend(Vec2(spec.centreX(jx + 1), spec.centreY(jy + 1)));
+  column.simple = freePieces(map, box, kWallMargin, column.pieces);
+  const std::vector<std::vector<Vec2>>& pieces = column.pieces;
+  const bool whole = column.simple && pieces.size() == 1 && pieces[0].size() == 4 && pieces[0][0] == box.min &&
+                     pieces[0][2] == box.max;
+  const int corner_x[4] = { jx, jx + 1, jx + 1, jx };
+  const int corner_y[4] = { jy, jy, jy + 1, jy + 1 };
+  column.vertex_hits.clear();
+  for (const std::vector<Vec2>& piece : pieces)
+  {
+    for (std::size_t k = 0; k < piece.size(); ++k)
+    {
+      std::vector<int> h(spec.nt);
+      for (int it = 0; it < spec.nt; ++it)
+      {
+        const double t = spec.centreTheta(it);
+        h[it] = whole ? hits[spec.index(corner_x[k], corner_y[k], it)] :
+                        map.cast(piece[k], Vec2(std::cos(t), std::sin(t))).segment;
+      }
+      column.vertex_hits.push_back(std::move(h));
+    }
+  }
+}
+
+/// The union of the pieces' bounds over heading cell @p jt.
+DistanceInterval cellBound(const MapRayCaster& map, const EdgeRings& rings, const GridSpec& spec, const Column& column,
+                           int jt, std::vector<int>& h)
+{
+  if (!column.simple)
+  {
+    return DistanceInterval{ 0.0, kInf };
+  }
+  const double t0 = spec.centreTheta(jt);
+  const int jt1 = (jt + 1) % spec.nt;
+  DistanceInterval bound;
+  std::size_t vertex = 0;
+  for (const std::vector<Vec2>& piece : column.pieces)
+  {
+    h.clear();
+    for (std::size_t k = 0; k < piece.size(); ++k, ++vertex)
+    {
+      h.push_back(column.vertex_hits[vertex][jt]);
+      h.push_back(column.vertex_hits[vertex][jt1]);
+    }
+    const DistanceInterval b = pieceBound(map, rings, piece, t0, t0 + spec.thetaStep(), h);
+    bound.lo = std::min(bound.lo, b.lo);
+    bound.hi = std::max(bound.hi, b.hi);
+  }
+  return bound;
+}
+}  // namespace
+
 CellBounds CellBounds::compute(const MapRayCaster& map, const GridSpec& spec, int threads)
 {
   CellBounds out;
@@ -178,7 +246,6 @@ CellBounds CellBounds::compute(const MapRayCaster& map, const GridSpec& spec, in
   const std::size_t cells = static_cast<std::size_t>(out.paddedNx()) * out.paddedNy() * spec.nt;
   out.lower_.assign(cells, std::numeric_limits<float>::infinity());
   out.upper_.assign(cells, -std::numeric_limits<float>::infinity());
-  const int nt = spec.nt;
   const std::vector<int> hits = sampleHits(map, spec, threads);
   const EdgeRings rings(map.map());
   const long columns = static_cast<long>(spec.nx - 1) * (spec.ny - 1);
@@ -188,56 +255,12 @@ CellBounds CellBounds::compute(const MapRayCaster& map, const GridSpec& spec, in
   {
     const int jx = static_cast<int>(c % (spec.nx - 1));
     const int jy = static_cast<int>(c / (spec.nx - 1));
-    Box2 box;
-    box.extend(Vec2(spec.centreX(jx), spec.centreY(jy)));
-    box.extend(Vec2(spec.centreX(jx + 1), spec.centreY(jy + 1)));
-    std::vector<std::vector<Vec2>> pieces;
-    const bool simple = freePieces(map, box, kWallMargin, pieces);
-    const bool whole =
-        simple && pieces.size() == 1 && pieces[0].size() == 4 && pieces[0][0] == box.min && pieces[0][2] == box.max;
-    // Hit segments per piece vertex and sample heading.
-    std::vector<std::vector<int>> vertex_hits;
-    if (!whole)
-    {
-      for (const std::vector<Vec2>& piece : pieces)
-      {
-        for (const Vec2& v : piece)
-        {
-          std::vector<int> h(nt);
-          for (int it = 0; it < nt; ++it)
-          {
-            const double t = spec.centreTheta(it);
-            h[it] = map.cast(v, Vec2(std::cos(t), std::sin(t))).segment;
-          }
-          vertex_hits.push_back(std::move(h));
-        }
-      }
-    }
-    const int corner_x[4] = { jx, jx + 1, jx + 1, jx };
-    const int corner_y[4] = { jy, jy, jy + 1, jy + 1 };
+    Column column;
+    columnPieces(map, spec, hits, jx, jy, column);
     std::vector<int> h;
-    for (int jt = 0; jt < nt; ++jt)
+    for (int jt = 0; jt < spec.nt; ++jt)
     {
-      const double t0 = spec.centreTheta(jt);
-      const int jt1 = (jt + 1) % nt;
-      DistanceInterval bound;
-      if (!simple)
-      {
-        bound = DistanceInterval{ 0.0, kInf };
-      }
-      std::size_t vertex = 0;
-      for (std::size_t p = 0; simple && p < pieces.size(); ++p)
-      {
-        h.clear();
-        for (std::size_t k = 0; k < pieces[p].size(); ++k, ++vertex)
-        {
-          h.push_back(whole ? hits[spec.index(corner_x[k], corner_y[k], jt)] : vertex_hits[vertex][jt]);
-          h.push_back(whole ? hits[spec.index(corner_x[k], corner_y[k], jt1)] : vertex_hits[vertex][jt1]);
-        }
-        const DistanceInterval b = pieceBound(map, rings, pieces[p], t0, t0 + spec.thetaStep(), h);
-        bound.lo = std::min(bound.lo, b.lo);
-        bound.hi = std::max(bound.hi, b.hi);
-      }
+      const DistanceInterval bound = cellBound(map, rings, spec, column, jt, h);
       fallback += std::isinf(bound.hi) && bound.hi > 0.0 ? 1 : 0;
       const std::size_t i = out.index(jx, jy, jt);
       out.lower_[i] = roundDown(bound.lo);

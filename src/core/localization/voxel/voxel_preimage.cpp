@@ -67,6 +67,74 @@ void markRow(const float* rmin, const float* rmax, int begin, int end, float lo,
   }
 }
 
+/// The window arrays one slice of one reading reads, at its heading cells; x and y windows of two
+/// cells start at dx0 + k (k < nwx) and dy0 + k relative to the voxel; window index = cell + 1.
+struct SliceWindows
+{
+  int dx0 = 0;
+  int nwx = 0;
+  int dy0 = 0;
+  int nwy = 0;
+  const float* lower = nullptr;
+  const float* upper = nullptr;
+  const float* inner = nullptr;  ///< cone readings only
+};
+
+struct RowBuffers
+{
+  explicit RowBuffers(int nx) : lo(nx), hi(nx), in(nx)
+  {}
+  std::vector<float> lo;
+  std::vector<float> hi;
+  std::vector<float> in;
+};
+
+/// Marks row iy: the bounds over the slice's windows (min of the lower, max of the upper bounds,
+/// and for cones the min with the max of the inner upper bounds) against the reading's band.
+template <class Plan>
+void fillRow(const GridSpec& spec, const SliceWindows& w, const Plan& plan, int iy, RowBuffers& rows,
+             std::uint64_t* out)
+{
+  const int nx = spec.nx;
+  const std::size_t ny = static_cast<std::size_t>(spec.ny);
+  if (w.nwx == 1 && w.nwy == 1 && !w.inner && w.dx0 + 1 >= 0)
+  {
+    // One window: read the arrays in place.
+    const int wy = iy + w.dy0 + 1;
+    const int shift = w.dx0 + 1;
+    if (wy >= 0 && wy < spec.ny)
+    {
+      const std::size_t row = static_cast<std::size_t>(wy) * nx + shift;
+      markRow(w.lower + row, w.upper + row, 0, std::min(nx, nx - shift), plan.lo, plan.hi, plan.no_return, out);
+    }
+    return;
+  }
+  const float inf = std::numeric_limits<float>::infinity();
+  std::fill(rows.lo.begin(), rows.lo.end(), inf);
+  std::fill(rows.hi.begin(), rows.hi.end(), -inf);
+  std::fill(rows.in.begin(), rows.in.end(), w.inner ? -inf : inf);
+  for (int ky = 0; ky < w.nwy; ++ky)
+  {
+    const int wy = iy + w.dy0 + ky + 1;
+    for (int kx = 0; kx < w.nwx && wy >= 0 && static_cast<std::size_t>(wy) < ny; ++kx)
+    {
+      const int shift = w.dx0 + kx + 1;  // window index wx = ix + shift
+      const std::size_t row = static_cast<std::size_t>(wy) * nx + shift;
+      for (int ix = std::max(0, -shift); ix < std::min(nx, nx - shift); ++ix)
+      {
+        rows.lo[ix] = std::min(rows.lo[ix], w.lower[row + ix]);
+        rows.hi[ix] = std::max(rows.hi[ix], w.upper[row + ix]);
+        rows.in[ix] = w.inner ? std::max(rows.in[ix], w.inner[row + ix]) : inf;
+      }
+    }
+  }
+  for (int ix = 0; ix < nx; ++ix)
+  {
+    rows.hi[ix] = std::min(rows.hi[ix], rows.in[ix]);
+  }
+  markRow(rows.lo.data(), rows.hi.data(), 0, nx, plan.lo, plan.hi, plan.no_return, out);
+}
+
 /// Cells [first, first + count) (lattice units, relative) covering [a, b] widened by kEps.
 bool cellRange(double a, double b, double limit, int& first, int& count)
 {
@@ -190,9 +258,6 @@ void VoxelEngine::fillPreimageSlice(const Reading& reading, int it, VoxelSet& se
   {
     return;
   }
-  const int nx = spec_.nx;
-  const int ny = spec_.ny;
-  const int nt = spec_.nt;
   // Sensor positions of voxel (ix, iy, it), in position-lattice units: within r of the centre's
   // (+) g, the arc of g over the voxel's headings being no longer than |g| dt / 2.
   const double theta = spec_.centreTheta(it);
@@ -201,69 +266,28 @@ void VoxelEngine::fillPreimageSlice(const Reading& reading, int it, VoxelSet& se
   const double ox = (c * reading.offset.x - s * reading.offset.y) / spec_.cell;
   const double oy = (s * reading.offset.x + c * reading.offset.y) / spec_.cell;
   const double r = 0.5 * std::hypot(reading.offset.x, reading.offset.y) * spec_.thetaStep() / spec_.cell;
-  int dx0 = 0;
-  int nwx = 0;
-  int dy0 = 0;
-  int nwy = 0;
-  const double limit = 4.0 * (nx + ny) + 8.0;
-  if (!cellRange(ox - r - 0.5, ox + r + 0.5, limit, dx0, nwx) ||
-      !cellRange(oy - r - 0.5, oy + r + 0.5, limit, dy0, nwy))
+  SliceWindows w;
+  const double limit = 4.0 * (spec_.nx + spec_.ny) + 8.0;
+  if (!cellRange(ox - r - 0.5, ox + r + 0.5, limit, w.dx0, w.nwx) ||
+      !cellRange(oy - r - 0.5, oy + r + 0.5, limit, w.dy0, w.nwy))
   {
     return;  // the sensor is nowhere near the grid for any voxel of this slice
   }
-  // Windows of two cells starting at dx0 .. dx0 + nwx - 1 cover cells dx0 .. dx0 + nwx; window
-  // index = first cell + 1.
-  nwx = std::max(1, nwx - 1);
-  nwy = std::max(1, nwy - 1);
+  // Windows of two cells starting at dx0 .. dx0 + nwx - 1 cover cells dx0 .. dx0 + nwx.
+  w.nwx = std::max(1, w.nwx - 1);
+  w.nwy = std::max(1, w.nwy - 1);
+  const int nt = spec_.nt;
   auto wrapT = [nt](int t) { return ((t % nt) + nt) % nt; };
-  const float* lower = windows_.get(Kind::Lower, plan.lower.count).data();
-  const float* upper = windows_.get(Kind::UpperMax, plan.ray.count).data();
-  const float* inner = plan.inner.count > 0 ? windows_.get(Kind::UpperInner, plan.inner.count).data() : nullptr;
-  const int t_lower = wrapT(it + plan.lower.first);
-  const int t_upper = wrapT(it + plan.ray.first);
-  const int t_inner = wrapT(it + plan.inner.first);
-  std::vector<float> rlo(nx);
-  std::vector<float> rhi(nx);
-  std::vector<float> rin(nx);
-  for (int iy = 0; iy < ny; ++iy)
+  w.lower = windows_.get(Kind::Lower, plan.lower.count).data() + spec_.index(0, 0, wrapT(it + plan.lower.first));
+  w.upper = windows_.get(Kind::UpperMax, plan.ray.count).data() + spec_.index(0, 0, wrapT(it + plan.ray.first));
+  if (plan.inner.count > 0)
   {
-    std::fill(rlo.begin(), rlo.end(), std::numeric_limits<float>::infinity());
-    std::fill(rhi.begin(), rhi.end(), -std::numeric_limits<float>::infinity());
-    std::fill(rin.begin(), rin.end(), -std::numeric_limits<float>::infinity());
-    bool any = false;
-    for (int ky = 0; ky < nwy; ++ky)
-    {
-      const int wy = iy + dy0 + ky + 1;
-      if (wy < 0 || wy >= ny)
-      {
-        continue;
-      }
-      for (int kx = 0; kx < nwx; ++kx)
-      {
-        const int shift = dx0 + kx + 1;  // window index wx = ix + shift
-        const int begin = std::max(0, -shift);
-        const int end = std::min(nx, nx - shift);
-        const float* lo = lower + spec_.index(0, wy, t_lower) + shift;
-        const float* hi = upper + spec_.index(0, wy, t_upper) + shift;
-        const float* in = inner ? inner + spec_.index(0, wy, t_inner) + shift : nullptr;
-        for (int ix = begin; ix < end; ++ix)
-        {
-          rlo[ix] = std::min(rlo[ix], lo[ix]);
-          rhi[ix] = std::max(rhi[ix], hi[ix]);
-          rin[ix] = in ? std::max(rin[ix], in[ix]) : std::numeric_limits<float>::infinity();
-        }
-        any = any || begin < end;
-      }
-    }
-    if (!any)
-    {
-      continue;
-    }
-    for (int ix = 0; ix < nx; ++ix)
-    {
-      rhi[ix] = std::min(rhi[ix], rin[ix]);
-    }
-    markRow(rlo.data(), rhi.data(), 0, nx, plan.lo, plan.hi, plan.no_return, set.row(iy, it));
+    w.inner = windows_.get(Kind::UpperInner, plan.inner.count).data() + spec_.index(0, 0, wrapT(it + plan.inner.first));
+  }
+  RowBuffers rows(spec_.nx);
+  for (int iy = 0; iy < spec_.ny; ++iy)
+  {
+    fillRow(spec_, w, plan, iy, rows, set.row(iy, it));
   }
 }
 

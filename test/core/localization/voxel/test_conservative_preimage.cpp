@@ -63,6 +63,34 @@ Pose2 grazingTruth(const MapRayCaster& map, Pose2 truth, const Pose2& g, std::mt
   return truth;
 }
 
+/// Exact readings (cone readings of random half-angles up to @p max_half_angle, 10 % without a
+/// return within a random max range) from the sensors in free space.
+std::vector<Reading> exactConeReadings(const MapRayCaster& map, const Pose2& truth, const std::vector<Pose2>& offsets,
+                                       double max_half_angle, std::mt19937_64& rng)
+{
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<Reading> readings;
+  for (const Pose2& g : offsets)
+  {
+    const Pose2 sensor = compose(truth, g);
+    if (!map.isFree(sensor.position()))
+    {
+      continue;  // a sensor inside a wall measures nothing
+    }
+    Reading r;
+    r.offset = g;
+    r.half_angle = max_half_angle > 0.0 ? unit(rng) * max_half_angle : 0.0;
+    r.range = coneRange(map, sensor, r.half_angle);
+    if (unit(rng) < 0.1)
+    {
+      r.max_range = r.range * (0.5 + 0.5 * unit(rng));
+      r.range = kInf;
+    }
+    readings.push_back(r);
+  }
+  return readings;
+}
+
 struct Trial
 {
   std::size_t readings = 0;
@@ -93,25 +121,7 @@ Trial runTrials(const std::shared_ptr<const MapRayCaster>& map, int resolution, 
     {
       truth = grazingTruth(*map, truth, offsets[n % offsets.size()], rng);
     }
-    std::vector<Reading> readings;
-    for (const Pose2& g : offsets)
-    {
-      const Pose2 sensor = compose(truth, g);
-      if (!map->isFree(sensor.position()))
-      {
-        continue;  // a sensor inside a wall measures nothing
-      }
-      Reading r;
-      r.offset = g;
-      r.half_angle = max_half_angle > 0.0 ? unit(rng) * max_half_angle : 0.0;
-      r.range = coneRange(*map, sensor, r.half_angle);
-      if (unit(rng) < 0.1)
-      {
-        r.max_range = r.range * (0.5 + 0.5 * unit(rng));  // no return within the max range
-        r.range = kInf;
-      }
-      readings.push_back(r);
-    }
+    const std::vector<Reading> readings = exactConeReadings(*map, truth, offsets, max_half_angle, rng);
     int ix = 0;
     int iy = 0;
     int it = 0;
@@ -175,13 +185,13 @@ TEST(ConservativePreimage, TruthNeverPrunedOnRandomMaps)
 {
   std::mt19937_64 rng(1616);
   std::size_t readings = 0;
-  for (int m = 0; m < 12; ++m)
+  for (int m = 0; m < 10; ++m)
   {
     const Trial t = runTrials(randomMap(rng), 24 + 8 * (m % 4), 100, 0.0, rng);
     EXPECT_EQ(t.missed, 0u) << "map " << m << ": " << t.missed << " of " << t.readings;
     readings += t.readings;
   }
-  EXPECT_GT(readings, 5000u);
+  EXPECT_GT(readings, 4000u);
 }
 
 TEST(ConservativePreimage, ConeReadingsKeepTheTruth)

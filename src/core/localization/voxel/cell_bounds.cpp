@@ -19,18 +19,6 @@ constexpr double kWallMargin = 1e-6;
 /// A position box that is not one of the simple cases is split in four, at most this many times.
 constexpr int kSplitDepth = 3;
 
-float roundDown(double value)
-{
-  float f = static_cast<float>(value);
-  return static_cast<double>(f) > value ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
-}
-
-float roundUp(double value)
-{
-  float f = static_cast<float>(value);
-  return static_cast<double>(f) < value ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
-}
-
 /// The free side of @p s (its left), moved in by @p margin.
 HalfPlane freeSide(const Segment& s, double margin)
 {

@@ -9,6 +9,7 @@
 #endif
 
 #include <algorithm>
+#include <cstddef>
 #include <cmath>
 #include <limits>
 
@@ -24,25 +25,16 @@ constexpr double kEps = 1e-9;  ///< cells: lattice coordinates are widened by th
 /// about half a cell times the slope difference, so its band is widened by this many cells.
 constexpr double kKinkMargin = 0.5;
 
-float roundDown(double value)
+/// Sets bit ix of @p row for ix in [begin, end) when [rmin[ix + shift], rmax[ix + shift]] meets
+/// [lo, hi] (no_return: when rmax[ix + shift] >= lo); ix + shift >= 0 on that range.
+void markRow(const float* rmin_base, const float* rmax_base, std::ptrdiff_t shift, int begin, int end, float lo,
+             float hi, bool no_return, std::uint64_t* row)
 {
-  const float f = static_cast<float>(value);
-  return static_cast<double>(f) > value ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
-}
-
-float roundUp(double value)
-{
-  const float f = static_cast<float>(value);
-  return static_cast<double>(f) < value ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
-}
-
-/// Sets bit ix of @p row for ix in [begin, end) when [rmin[ix], rmax[ix]] meets [lo, hi]
-/// (no_return: when rmax[ix] >= lo).
-void markRow(const float* rmin, const float* rmax, int begin, int end, float lo, float hi, bool no_return,
-             std::uint64_t* row)
-{
+  // Shifted views, formed only for the indices read (no pointer before an array).
+  auto rmin = [&](int ix) { return rmin_base + (ix + shift); };
+  auto rmax = [&](int ix) { return rmax_base + (ix + shift); };
   auto scalar = [&](int ix) {
-    const bool in = no_return ? rmax[ix] >= lo : (rmin[ix] <= hi && rmax[ix] >= lo);
+    const bool in = no_return ? *rmax(ix) >= lo : (*rmin(ix) <= hi && *rmax(ix) >= lo);
     row[ix >> 6] |= static_cast<std::uint64_t>(in) << (ix & 63);
   };
   int ix = begin;
@@ -56,8 +48,8 @@ void markRow(const float* rmin, const float* rmax, int begin, int end, float lo,
   const __m128 vhi = _mm_set1_ps(no_return ? std::numeric_limits<float>::infinity() : hi);
   for (; ix + 4 <= end; ix += 4)
   {
-    const __m128 below = _mm_cmple_ps(_mm_loadu_ps(rmin + ix), vhi);
-    const __m128 in = _mm_and_ps(below, _mm_cmpge_ps(_mm_loadu_ps(rmax + ix), vlo));
+    const __m128 below = _mm_cmple_ps(_mm_loadu_ps(rmin(ix)), vhi);
+    const __m128 in = _mm_and_ps(below, _mm_cmpge_ps(_mm_loadu_ps(rmax(ix)), vlo));
     row[ix >> 6] |= static_cast<std::uint64_t>(_mm_movemask_ps(in)) << (ix & 63);
   }
 #endif
@@ -105,7 +97,8 @@ void fillRow(const GridSpec& spec, const SliceWindows& w, const Plan& plan, int 
     if (wy >= 0 && wy < spec.ny)
     {
       const std::size_t row = static_cast<std::size_t>(wy) * nx + shift;
-      markRow(w.lower + row, w.upper + row, 0, std::min(nx, nx - shift), plan.lo, plan.hi, plan.no_return, out);
+      markRow(w.lower, w.upper, static_cast<std::ptrdiff_t>(row), 0, std::min(nx, nx - shift), plan.lo, plan.hi,
+              plan.no_return, out);
     }
     return;
   }
@@ -132,7 +125,7 @@ void fillRow(const GridSpec& spec, const SliceWindows& w, const Plan& plan, int 
   {
     rows.hi[ix] = std::min(rows.hi[ix], rows.in[ix]);
   }
-  markRow(rows.lo.data(), rows.hi.data(), 0, nx, plan.lo, plan.hi, plan.no_return, out);
+  markRow(rows.lo.data(), rows.hi.data(), 0, 0, nx, plan.lo, plan.hi, plan.no_return, out);
 }
 
 /// Cells [first, first + count) (lattice units, relative) covering [a, b] widened by kEps.
@@ -185,8 +178,8 @@ void VoxelEngine::fillSampleSlice(const Reading& reading, int it, VoxelSet& set)
   const float* bmax = table_.blockMax().data();
   for (int iy = y_begin; iy < y_end; ++iy)
   {
-    const std::size_t base = static_cast<std::size_t>(t0) * slice + static_cast<std::size_t>(iy + sy) * nx + sx;
-    markRow(bmin + base, bmax + base, x_begin, x_end, lo, hi, no_return, set.row(iy, it));
+    const std::ptrdiff_t base = static_cast<std::ptrdiff_t>(t0 * slice + static_cast<std::size_t>(iy + sy) * nx) + sx;
+    markRow(bmin, bmax, base, x_begin, x_end, lo, hi, no_return, set.row(iy, it));
   }
 }
 

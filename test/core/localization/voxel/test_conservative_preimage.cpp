@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <random>
 #include <string>
 
@@ -176,6 +177,7 @@ TEST(ConservativePreimage, TruthNeverPrunedOnBundledMaps)
        { "maps/l_room.poly", "maps/square_room.poly", "maps/apartment.poly", "maps/office.poly", "maps/corridor.poly" })
   {
     const Trial t = runTrials(test::loadMap(name), 40, 150, 0.0, rng);
+    std::printf("[ STATS    ] %s: truth's voxel missed by %zu of %zu preimages\n", name.c_str(), t.missed, t.readings);
     EXPECT_EQ(t.missed, 0u) << name << ": " << t.missed << " of " << t.readings;
     EXPECT_GT(t.readings, 700u) << name;
   }
@@ -191,6 +193,7 @@ TEST(ConservativePreimage, TruthNeverPrunedOnRandomMaps)
     EXPECT_EQ(t.missed, 0u) << "map " << m << ": " << t.missed << " of " << t.readings;
     readings += t.readings;
   }
+  std::printf("[ STATS    ] random maps: %zu preimages\n", readings);
   EXPECT_GT(readings, 4000u);
 }
 
@@ -201,6 +204,7 @@ TEST(ConservativePreimage, ConeReadingsKeepTheTruth)
   {
     const auto map = m == 0 ? test::loadMap("maps/apartment.poly") : randomMap(rng);
     const Trial t = runTrials(map, 32, 100, 0.5, rng);
+    std::printf("[ STATS    ] cones, map %d: truth's voxel missed by %zu of %zu preimages\n", m, t.missed, t.readings);
     EXPECT_EQ(t.missed, 0u) << "map " << m << ": " << t.missed << " of " << t.readings;
     EXPECT_GT(t.readings, 400u);
   }

@@ -17,7 +17,9 @@
 #include "fdml_localization/core/geometry/ray_caster.h"
 #include "fdml_localization/core/localization/voxel/voxel_grid.h"
 
+#include <cmath>
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 namespace fdml_localization
@@ -30,6 +32,20 @@ struct DistanceInterval
   double lo = kInf;
   double hi = -kInf;
 };
+
+/// @p value rounded to a float not above it (bounds are stored rounded outward).
+inline float roundDown(double value)
+{
+  const float f = static_cast<float>(value);
+  return static_cast<double>(f) > value ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+}
+
+/// @p value rounded to a float not below it.
+inline float roundUp(double value)
+{
+  const float f = static_cast<float>(value);
+  return static_cast<double>(f) < value ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+}
 
 /// Ring topology of a map's edges (MapRayCaster's segment order: ring by ring, vertex order).
 struct EdgeRings

@@ -36,7 +36,7 @@ void addPiece(std::vector<Vec2> poly, std::vector<std::vector<Vec2>>& pieces)
 }
 
 /// Hit segment of every sample ray (-1 where the sample's position is not free).
-std::vector<int> sampleHits(const MapRayCaster& map, const GridSpec& spec, int threads)
+std::vector<int> sampleHits(const MapRayCaster& map, const GridSpec& spec, const std::vector<Vec2>& dirs, int threads)
 {
   std::vector<int> hits(spec.voxelCount(), -1);
   const std::size_t slice = static_cast<std::size_t>(spec.nx) * spec.ny;
@@ -50,9 +50,7 @@ std::vector<int> sampleHits(const MapRayCaster& map, const GridSpec& spec, int t
     }
     for (int it = 0; it < spec.nt; ++it)
     {
-      const double t = spec.centreTheta(it);
-      hits[static_cast<std::size_t>(it) * slice + static_cast<std::size_t>(c)] =
-          map.cast(origin, Vec2(std::cos(t), std::sin(t))).segment;
+      hits[static_cast<std::size_t>(it) * slice + static_cast<std::size_t>(c)] = map.cast(origin, dirs[it]).segment;
     }
   }
   return hits;
@@ -170,8 +168,8 @@ struct Column
   std::vector<std::vector<int>> vertex_hits;
 };
 
-void columnPieces(const MapRayCaster& map, const GridSpec& spec, const std::vector<int>& hits, int jx, int jy,
-                  Column& column)
+void columnPieces(const MapRayCaster& map, const GridSpec& spec, const std::vector<Vec2>& dirs,
+                  const std::vector<int>& hits, int jx, int jy, Column& column)
 {
   Box2 box;
   box.extend(Vec2(spec.centreX(jx), spec.centreY(jy)));
@@ -190,9 +188,7 @@ void columnPieces(const MapRayCaster& map, const GridSpec& spec, const std::vect
       std::vector<int> h(spec.nt);
       for (int it = 0; it < spec.nt; ++it)
       {
-        const double t = spec.centreTheta(it);
-        h[it] = whole ? hits[spec.index(corner_x[k], corner_y[k], it)] :
-                        map.cast(piece[k], Vec2(std::cos(t), std::sin(t))).segment;
+        h[it] = whole ? hits[spec.index(corner_x[k], corner_y[k], it)] : map.cast(piece[k], dirs[it]).segment;
       }
       column.vertex_hits.push_back(std::move(h));
     }
@@ -200,14 +196,13 @@ void columnPieces(const MapRayCaster& map, const GridSpec& spec, const std::vect
 }
 
 /// The union of the pieces' bounds over heading cell @p jt.
-DistanceInterval cellBound(const MapRayCaster& map, const EdgeRings& rings, const GridSpec& spec, const Column& column,
-                           int jt, std::vector<int>& h)
+DistanceInterval cellBound(const MapRayCaster& map, const EdgeRings& rings, const GridSpec& spec,
+                           const std::vector<Vec2>& dirs, const Column& column, int jt, std::vector<int>& h)
 {
   if (!column.simple)
   {
     return DistanceInterval{ 0.0, kInf };
   }
-  const double t0 = spec.centreTheta(jt);
   const int jt1 = (jt + 1) % spec.nt;
   DistanceInterval bound;
   std::size_t vertex = 0;
@@ -219,7 +214,7 @@ DistanceInterval cellBound(const MapRayCaster& map, const EdgeRings& rings, cons
       h.push_back(column.vertex_hits[vertex][jt]);
       h.push_back(column.vertex_hits[vertex][jt1]);
     }
-    const DistanceInterval b = pieceBound(map, rings, piece, t0, t0 + spec.thetaStep(), h);
+    const DistanceInterval b = pieceBound(map, rings, piece, dirs[jt], dirs[jt1], h);
     bound.lo = std::min(bound.lo, b.lo);
     bound.hi = std::max(bound.hi, b.hi);
   }
@@ -234,7 +229,12 @@ CellBounds CellBounds::compute(const MapRayCaster& map, const GridSpec& spec, in
   const std::size_t cells = static_cast<std::size_t>(out.paddedNx()) * out.paddedNy() * spec.nt;
   out.lower_.assign(cells, std::numeric_limits<float>::infinity());
   out.upper_.assign(cells, -std::numeric_limits<float>::infinity());
-  const std::vector<int> hits = sampleHits(map, spec, threads);
+  std::vector<Vec2> dirs(spec.nt);
+  for (int it = 0; it < spec.nt; ++it)
+  {
+    dirs[it] = Vec2(std::cos(spec.centreTheta(it)), std::sin(spec.centreTheta(it)));
+  }
+  const std::vector<int> hits = sampleHits(map, spec, dirs, threads);
   const EdgeRings rings(map.map());
   const long columns = static_cast<long>(spec.nx - 1) * (spec.ny - 1);
   std::size_t fallback = 0;
@@ -244,11 +244,11 @@ CellBounds CellBounds::compute(const MapRayCaster& map, const GridSpec& spec, in
     const int jx = static_cast<int>(c % (spec.nx - 1));
     const int jy = static_cast<int>(c / (spec.nx - 1));
     Column column;
-    columnPieces(map, spec, hits, jx, jy, column);
+    columnPieces(map, spec, dirs, hits, jx, jy, column);
     std::vector<int> h;
     for (int jt = 0; jt < spec.nt; ++jt)
     {
-      const DistanceInterval bound = cellBound(map, rings, spec, column, jt, h);
+      const DistanceInterval bound = cellBound(map, rings, spec, dirs, column, jt, h);
       fallback += std::isinf(bound.hi) && bound.hi > 0.0 ? 1 : 0;
       const std::size_t i = out.index(jx, jy, jt);
       out.lower_[i] = roundDown(bound.lo);

@@ -162,8 +162,8 @@ bool runsCoverEveryRay(const Frame& f, std::vector<Run>& runs)
 }
 }  // namespace
 
-DistanceInterval pieceBound(const MapRayCaster& map, const EdgeRings& rings, const std::vector<Vec2>& piece, double t0,
-                            double t1, const std::vector<int>& hits)
+DistanceInterval pieceBound(const MapRayCaster& map, const EdgeRings& rings, const std::vector<Vec2>& piece,
+                            const Vec2& u0, const Vec2& u1, const std::vector<int>& hits)
 {
   static thread_local Scratch scratch;
   scratch.params.clear();
@@ -171,7 +171,7 @@ DistanceInterval pieceBound(const MapRayCaster& map, const EdgeRings& rings, con
   scratch.points.clear();
   scratch.wedge.clear();
   scratch.ahead.clear();
-  const Frame f{ map, rings, piece, { Vec2(std::cos(t0), std::sin(t0)), Vec2(std::cos(t1), std::sin(t1)) }, scratch };
+  const Frame f{ map, rings, piece, { u0, u1 }, scratch };
   buildWedge(f);
   if (!hitParams(f, hits) || !piece::groupRuns(rings, scratch) || !runsCoverEveryRay(f, scratch.runs))
   {

@@ -59,13 +59,15 @@ struct EdgeRings
 /**
  * @brief Bounds of h over {(p, phi) : p in the convex polygon @p piece, phi in [t0, t1]},
  *        0 < t1 - t0 < pi/2, from the first hits of the rays of the piece's vertices.
+ * @param u0 (cos t0, sin t0), the direction the hits at t0 were cast in
+ * @param u1 (cos t1, sin t1)
  * @param hits segment hit by the ray of vertex i at heading t0 (index 2 i) and t1 (2 i + 1),
  *        -1 for a miss
  * @return [lo, hi] with lo <= h <= hi for every pose of the piece in free space, or [0, +inf]
  *         when the argument does not apply
  */
-DistanceInterval pieceBound(const MapRayCaster& map, const EdgeRings& rings, const std::vector<Vec2>& piece, double t0,
-                            double t1, const std::vector<int>& hits);
+DistanceInterval pieceBound(const MapRayCaster& map, const EdgeRings& rings, const std::vector<Vec2>& piece,
+                            const Vec2& u0, const Vec2& u1, const std::vector<int>& hits);
 
 /**
  * @brief The free part of the position box as convex pieces, shrunk by @p margin from the

@@ -40,16 +40,20 @@ BoxOccupancy::BoxOccupancy(const MapRayCaster& map, double cell_size, int max_ce
   inv_cell_ = 1.0 / cell_;
   nx_ = std::max(1, static_cast<int>(std::ceil(size.x() / cell_)));
   ny_ = std::max(1, static_cast<int>(std::ceil(size.y() / cell_)));
+  const std::vector<std::uint8_t> edge = edgeCells(map, longest);
+  const std::vector<std::uint8_t> free_or_edge = freeOrEdgeCells(map, edge);
+  edge_sum_ = summedArea(edge, nx_, ny_);
+  free_sum_ = summedArea(free_or_edge, nx_, ny_);
+}
+
+std::vector<std::uint8_t> BoxOccupancy::edgeCells(const MapRayCaster& map, double longest) const
+{
   std::vector<std::uint8_t> edge(static_cast<std::size_t>(nx_) * ny_, 0);
   // Mark every cell an edge may touch: per column strip, the edge's y range there, widened by
   // a margin that absorbs rounding.
   const double margin = 1e-6 * longest + 1e-9;
-  auto clampX = [&](double x) {
-    return std::clamp(static_cast<int>(std::floor((x - bounds_.min.x()) / cell_)), 0, nx_ - 1);
-  };
-  auto clampY = [&](double y) {
-    return std::clamp(static_cast<int>(std::floor((y - bounds_.min.y()) / cell_)), 0, ny_ - 1);
-  };
+  auto clampX = [&](double x) { return cellIndex(x - bounds_.min.x(), nx_); };
+  auto clampY = [&](double y) { return cellIndex(y - bounds_.min.y(), ny_); };
   for (const Segment& s : map.map().edges())
   {
     const double xa = std::min(s.a.x(), s.b.x()) - margin, xb = std::max(s.a.x(), s.b.x()) + margin;
@@ -72,6 +76,12 @@ BoxOccupancy::BoxOccupancy(const MapRayCaster& map, double cell_size, int max_ce
       }
     }
   }
+  return edge;
+}
+
+std::vector<std::uint8_t> BoxOccupancy::freeOrEdgeCells(const MapRayCaster& map,
+                                                        const std::vector<std::uint8_t>& edge) const
+{
   // Regions of edge-free cells: one point-in-polygon test each.
   std::vector<std::uint8_t> free_or_edge(edge);
   std::vector<std::uint8_t> seen(edge);
@@ -113,8 +123,7 @@ BoxOccupancy::BoxOccupancy(const MapRayCaster& map, double cell_size, int max_ce
       }
     }
   }
-  edge_sum_ = summedArea(edge, nx_, ny_);
-  free_sum_ = summedArea(free_or_edge, nx_, ny_);
+  return free_or_edge;
 }
 
 std::int64_t BoxOccupancy::count(const std::vector<std::int32_t>& table, const Box2& box) const
@@ -137,9 +146,13 @@ std::int64_t BoxOccupancy::count(const std::vector<std::int32_t>& table, const B
 
 int BoxOccupancy::cellIndex(double offset, int cells) const
 {
-  // Clamped in floating point first (offsets may be far outside), then truncated (>= 0).
-  const double c = std::min(std::max(offset * inv_cell_, 0.0), static_cast<double>(cells - 1));
-  return static_cast<int>(c);
+  // Clamped in floating point first (offsets may be far outside, or NaN), then truncated (>= 0).
+  const double c = offset * inv_cell_;
+  if (!(c > 0.0))
+  {
+    return 0;
+  }
+  return c < cells - 1 ? static_cast<int>(c) : cells - 1;
 }
 
 bool BoxOccupancy::mayTouchEdge(const Box2& box) const

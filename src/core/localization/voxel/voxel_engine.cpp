@@ -5,9 +5,6 @@
 #include "fdml_localization/core/util/stopwatch.h"
 
 #include <omp.h>
-#ifdef __SSE2__
-#include <emmintrin.h>
-#endif
 
 #include <algorithm>
 #include <chrono>
@@ -22,47 +19,6 @@ namespace core
 {
 namespace
 {
-
-/// Where rays hit near a concave corner, h is the minimum of two linear pieces and peaks between
-/// samples, above all of them, by up to about the slope difference times half a cell: the band
-/// [d - tau, d + tau] is widened by this many cells so the truth's voxel stays in its preimage.
-constexpr double kKinkMargin = 0.5;
-
-int floorDiv(double value)
-{
-  return static_cast<int>(std::floor(value));
-}
-
-/// Sets bit ix of @p row for ix in [begin, end) when [rmin[ix], rmax[ix]] meets [lo, hi]
-/// (no_return: when rmax[ix] >= lo).
-void markRow(const float* rmin, const float* rmax, int begin, int end, float lo, float hi, bool no_return,
-             std::uint64_t* row)
-{
-  auto scalar = [&](int ix) {
-    const bool in = no_return ? rmax[ix] >= lo : (rmin[ix] <= hi && rmax[ix] >= lo);
-    row[ix >> 6] |= static_cast<std::uint64_t>(in) << (ix & 63);
-  };
-  int ix = begin;
-#ifdef __SSE2__
-  for (; ix < end && (ix & 3) != 0; ++ix)
-  {
-    scalar(ix);
-  }
-  // Four voxels per step; an aligned group of four never straddles two words.
-  const __m128 vlo = _mm_set1_ps(lo);
-  const __m128 vhi = _mm_set1_ps(no_return ? std::numeric_limits<float>::infinity() : hi);
-  for (; ix + 4 <= end; ix += 4)
-  {
-    const __m128 below = _mm_cmple_ps(_mm_loadu_ps(rmin + ix), vhi);
-    const __m128 in = _mm_and_ps(below, _mm_cmpge_ps(_mm_loadu_ps(rmax + ix), vlo));
-    row[ix >> 6] |= static_cast<std::uint64_t>(_mm_movemask_ps(in)) << (ix & 63);
-  }
-#endif
-  for (; ix < end; ++ix)
-  {
-    scalar(ix);
-  }
-}
 
 /// byte_spread[b] has byte j = bit j of b: adds 8 voxels' bits to 8 count bytes at once.
 struct ByteSpread
@@ -107,6 +63,7 @@ void VoxelEngine::prepare()
   }
   const auto start = std::chrono::steady_clock::now();
   table_ = loadOrBuildTable(*map_, spec_, options_.cache_dir, threads(), &table_source_, &cache_message_);
+  windows_ = BoundWindows(CellBounds::compute(*map_, spec_, threads()));
   prepared_ = true;
   prepare_seconds_ = secondsSince(start);
 }
@@ -117,52 +74,15 @@ const DistanceTable& VoxelEngine::table()
   return table_;
 }
 
-void VoxelEngine::fillPreimageSlice(const Reading& reading, int it, VoxelSet& set) const
-{
-  const int nx = spec_.nx;
-  const int ny = spec_.ny;
-  const int nt = spec_.nt;
-  const bool no_return = !std::isfinite(reading.range);
-  const double band = preimageBand();
-  const float lo = static_cast<float>(no_return ? reading.max_range - band : reading.range - band);
-  const float hi = static_cast<float>(reading.range + band);
-  const std::size_t slice = static_cast<std::size_t>(nx) * ny;
-  const double theta = spec_.centreTheta(it);
-  const double c = std::cos(theta);
-  const double s = std::sin(theta);
-  // (centre of voxel (ix, iy, it)) (+) g sits at sample-lattice coordinate (ix + ox / cell, ...):
-  // the same shift for the whole slice, so its sample block starts at (ix + sx, iy + sy, t0).
-  const double ox = c * reading.offset.x - s * reading.offset.y;
-  const double oy = s * reading.offset.x + c * reading.offset.y;
-  // A point exactly on a sample (g = 0, the first reading of a batch) takes the block that
-  // starts there, whatever the rounding of the lattice coordinate: hence the 1e-9.
-  const int sx = floorDiv(ox / spec_.cell + 1e-9);
-  const int sy = floorDiv(oy / spec_.cell + 1e-9);
-  const double phi = wrapAngle(theta + reading.offset.theta);
-  int t0 = floorDiv((phi + kPi) / spec_.thetaStep() - 0.5 + 1e-9) % nt;
-  t0 = t0 < 0 ? t0 + nt : t0;
-  // Blocks start at samples xx in [0, nx - 2] and yy in [0, ny - 2].
-  const int x_begin = std::max(0, -sx);
-  const int x_end = std::min(nx, nx - 1 - sx);
-  const int y_begin = std::max(0, -sy);
-  const int y_end = std::min(ny, ny - 1 - sy);
-  const float* bmin = table_.blockMin().data();
-  const float* bmax = table_.blockMax().data();
-  for (int iy = y_begin; iy < y_end; ++iy)
-  {
-    const std::size_t base = static_cast<std::size_t>(t0) * slice + static_cast<std::size_t>(iy + sy) * nx + sx;
-    markRow(bmin + base, bmax + base, x_begin, x_end, lo, hi, no_return, set.row(iy, it));
-  }
-}
-
 double VoxelEngine::preimageBand() const
 {
-  return options_.range_tolerance + kKinkMargin * spec_.cell;
+  return options_.range_tolerance;
 }
 
 VoxelSet VoxelEngine::rawPreimage(const Reading& reading)
 {
   prepare();
+  prepareWindows({ reading });
   VoxelSet set(spec_);
 #pragma omp parallel for schedule(static) num_threads(threads())
   for (int it = 0; it < spec_.nt; ++it)
@@ -181,21 +101,26 @@ std::vector<VoxelSet> VoxelEngine::preimages(const std::vector<Reading>& reading
 std::vector<VoxelSet> VoxelEngine::preimages(const std::vector<Reading>& readings, std::vector<VoxelSet>& raw)
 {
   prepare();
+  prepareWindows(readings);
   const long k = static_cast<long>(readings.size());
   const long nt = spec_.nt;
   raw.assign(readings.size(), VoxelSet(spec_));
-  std::vector<VoxelSet> sets(readings.size());
-#pragma omp parallel num_threads(threads())
+  std::vector<VoxelSet> sets(readings.size(), VoxelSet(spec_));
+#pragma omp parallel for schedule(static) num_threads(threads())
+  for (long job = 0; job < k * nt; ++job)
   {
-#pragma omp for schedule(static)
-    for (long job = 0; job < k * nt; ++job)
+    const Reading& r = readings[job / nt];
+    fillPreimageSlice(r, static_cast<int>(job % nt), sets[job / nt]);
+    if (!(r.half_angle > 0.0))
     {
-      fillPreimageSlice(readings[job / nt], static_cast<int>(job % nt), raw[job / nt]);
+      fillSampleSlice(r, static_cast<int>(job % nt), raw[job / nt]);
     }
-#pragma omp for schedule(dynamic, 1)
-    for (long i = 0; i < k; ++i)
+  }
+  for (std::size_t i = 0; i < readings.size(); ++i)
+  {
+    if (readings[i].half_angle > 0.0)
     {
-      sets[i] = raw[i].dilated();
+      raw[i] = sets[i];
     }
   }
   return sets;
@@ -290,6 +215,13 @@ Result VoxelEngine::localize(const std::vector<Reading>& readings)
   if (options_.method == Method::Robust)
   {
     countField(raw_sets_, raw_count_);
+    seed_sets_.resize(raw_sets_.size());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads())
+    for (long i = 0; i < static_cast<long>(raw_sets_.size()); ++i)
+    {
+      seed_sets_[i] = raw_sets_[i].dilated();
+    }
+    countField(seed_sets_, seed_count_);
   }
   result.times.count = secondsSince(stage);
 

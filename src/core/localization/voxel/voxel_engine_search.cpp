@@ -22,16 +22,16 @@ namespace core
 {
 namespace
 {
-/// The voxel engine's seeds, level by level: every locally maximal set of readings of the raw
-/// preimages (hypothesis_seeds.h) and, because the raw test can miss the truth's voxel next to a
-/// discontinuity of h, the count peaks of the dilated preimages.
+/// The voxel engine's seeds, level by level: every locally maximal set of readings of the
+/// seeding's sample preimages (hypothesis_seeds.h) and, because that test can miss the truth's
+/// voxel next to a discontinuity of h, the count peaks of their dilation.
 class VoxelSeeds : public SeedSource
 {
 public:
   VoxelSeeds(const VoxelEngine& engine, int lowest, int k, StageTimes& times) : engine_(engine), times_(times)
   {
     const auto stage = std::chrono::steady_clock::now();
-    buckets_ = voxelsByCount(engine.lastCount(), lowest, k);
+    buckets_ = voxelsByCount(engine.lastSeedCount(), lowest, k);
     raw_buckets_ = voxelsByCount(engine.lastRawCount(), lowest, k);
     times_.components += secondsSince(stage);
   }
@@ -46,9 +46,9 @@ public:
     {
       seeds.push_back(seedOf(h.plateau, std::move(h.hypothesis)));
     }
-    for (VoxelCluster& c : regionalMaxima(spec, engine_.lastCount(), level, buckets_[level]))
+    for (VoxelCluster& c : regionalMaxima(spec, engine_.lastSeedCount(), level, buckets_[level]))
     {
-      seeds.push_back(seedOf(c, engine_.membership(c.representative, engine_.lastPreimages())));
+      seeds.push_back(seedOf(c, engine_.membership(c.representative, engine_.lastSeedPreimages())));
     }
     times_.components += secondsSince(stage);
     return seeds;

@@ -19,6 +19,31 @@ std::uint64_t mixHash(std::uint64_t h, std::uint64_t value)
   return h ^ (h >> 33);
 }
 
+/// Each row of @p wpr words dilated by one bit both ways (no carry between rows).
+void dilateAlongX(const std::uint64_t* words, std::uint64_t* result, std::size_t rows, int wpr, std::uint64_t tail_mask)
+{
+  for (std::size_t r = 0; r < rows; ++r)
+  {
+    const std::uint64_t* in = words + r * wpr;
+    std::uint64_t* out = result + r * wpr;
+    for (int k = 0; k < wpr; ++k)
+    {
+      const std::uint64_t w = in[k];
+      std::uint64_t d = w | (w << 1) | (w >> 1);
+      if (k > 0)
+      {
+        d |= in[k - 1] >> 63;
+      }
+      if (k + 1 < wpr)
+      {
+        d |= in[k + 1] << 63;
+      }
+      out[k] = d;
+    }
+    out[wpr - 1] &= tail_mask;
+  }
+}
+
 std::uint64_t doubleBits(double value)
 {
   std::uint64_t bits = 0;
@@ -85,20 +110,18 @@ Pose2 GridSpec::centre(std::size_t v) const
 
 bool GridSpec::locate(const Pose2& pose, int& ix, int& iy, int& it) const
 {
-  const double fx = std::floor((pose.x - origin_x) / cell);
-  const double fy = std::floor((pose.y - origin_y) / cell);
-  if (!(fx >= 0.0 && fx < nx && fy >= 0.0 && fy < ny))
+  int fx = 0;
+  int fy = 0;
+  int ft = 0;
+  if (!floorIndex((pose.x - origin_x) / cell, 2.0 * nx + 2.0, fx) ||
+      !floorIndex((pose.y - origin_y) / cell, 2.0 * ny + 2.0, fy) || fx < 0 || fx >= nx || fy < 0 || fy >= ny ||
+      !floorIndex((wrapAngle(pose.theta) + kPi) / thetaStep(), 2.0 * nt + 2.0, ft))
   {
     return false;
   }
-  ix = static_cast<int>(fx);
-  iy = static_cast<int>(fy);
-  const double ft = std::floor((wrapAngle(pose.theta) + kPi) / thetaStep());
-  it = static_cast<int>(ft) % nt;
-  if (it < 0)
-  {
-    it += nt;
-  }
+  ix = fx;
+  iy = fy;
+  it = ((ft % nt) + nt) % nt;
   return true;
 }
 
@@ -149,26 +172,7 @@ VoxelSet VoxelSet::dilated() const
 
   // Along x, inside each row.
   VoxelSet along_x(*this);
-  for (std::size_t r = 0; r < rows; ++r)
-  {
-    const std::uint64_t* in = words_.data() + r * wpr;
-    std::uint64_t* out = along_x.words_.data() + r * wpr;
-    for (int k = 0; k < wpr; ++k)
-    {
-      const std::uint64_t w = in[k];
-      std::uint64_t d = w | (w << 1) | (w >> 1);
-      if (k > 0)
-      {
-        d |= in[k - 1] >> 63;
-      }
-      if (k + 1 < wpr)
-      {
-        d |= in[k + 1] << 63;
-      }
-      out[k] = d;
-    }
-    out[wpr - 1] &= tail_mask;
-  }
+  dilateAlongX(words_.data(), along_x.words_.data(), rows, wpr, tail_mask);
   // Along y, inside each theta slice.
   VoxelSet along_y(*this);
   for (int it = 0; it < nt_; ++it)

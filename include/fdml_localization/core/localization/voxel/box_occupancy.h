@@ -54,6 +54,13 @@ private:
   /// Number of marked cells in the clamped cell range covering the box (0 when outside).
   std::int64_t count(const std::vector<std::int32_t>& table, const Box2& box) const;
 
+  /// 1 for every cell an edge may touch (per column strip, the edge's y range there, widened by
+  /// a margin that absorbs rounding; @p longest is the bounds' longer side [m]).
+  std::vector<std::uint8_t> edgeCells(const MapRayCaster& map, double longest) const;
+  /// 1 for edge cells and for the cells of edge-free regions inside free space (one
+  /// point-in-polygon test per region).
+  std::vector<std::uint8_t> freeOrEdgeCells(const MapRayCaster& map, const std::vector<std::uint8_t>& edge) const;
+
   /// Cell index along an axis of an offset from the bounds' minimum [m], clamped to [0, cells).
   int cellIndex(double offset, int cells) const;
 

@@ -6,6 +6,7 @@
  */
 #pragma once
 
+#include "fdml_localization/core/localization/voxel/bound_windows.h"
 #include "fdml_localization/core/localization/voxel/distance_table.h"
 #include "fdml_localization/core/localization/localizer.h"
 #include "fdml_localization/core/localization/voxel/table_cache.h"
@@ -21,11 +22,12 @@ namespace fdml_localization
 namespace core
 {
 /**
- * @brief The voxel engine. Per call: (1) the preimage of each reading by the sign-change test
- *        on the distance table's 2 x 2 x 2 sample blocks, then a one-voxel dilation (bit-packed
- *        sets); (2) the count field (uint8 per voxel), M_k' = {count >= k'}; (3) seeds.
- *        Robust method, level by level from k down: the maximal hypotheses of the raw
- *        preimages (hypothesis_seeds.h) and the regional maxima of the dilated count field,
+ * @brief The voxel engine. Per call: (1) the preimage of each reading, conservative: voxel v is
+ *        in it when d lies within the bounds of h (cell_bounds.h) over every sensor pose
+ *        v (+) g can take, widened by tau (bit-packed sets; docs/METHOD.md); (2) the count field
+ *        (uint8 per voxel), M_k' = {count >= k'}, which always holds the truth's voxel; (3) seeds.
+ *        Robust method, level by level from k down: the maximal hypotheses of the seeding's
+ *        sample preimages (hypothesis_seeds.h) and the regional maxima of their dilated count,
  *        each refined by refineSeed() (exact ray casts, robust polish) once at least level - 2
  *        readings roughly agree at its centroid; in automatic mode k' is the first level some
  *        seed reaches net of contradicted readings (betterCandidate()), and the seeds that
@@ -62,28 +64,27 @@ public:
     return cache_message_;
   }
 
-  /**
-   * @brief Half-width b of the band [d - b, d + b] the preimages test [m]: the range tolerance
-   *        tau plus half a cell, because where a ray hits near a concave corner h peaks between
-   *        samples, above all of them, by up to about half a cell times the slope difference.
-   */
+  /// Half-width tau of the band [d - tau, d + tau] the preimages test around the bounds of h [m].
   double preimageBand() const;
 
   /**
-   * @brief The voxel preimage of one reading before dilation: voxel v is in it when the
-   *        samples of h around (centre of v) (+) g take values on both sides of [d - b, d + b]
-   *        or inside it (for d = +inf: some sample exceeds max_range - b), b = preimageBand().
-   *        Prepares on first use.
+   * @brief The conservative preimage of one reading (cone readings included): voxel v is in it
+   *        whenever some pose in v explains the reading within tau. Prepares on first use.
    */
   VoxelSet rawPreimage(const Reading& reading);
-  /// The dilated preimages of a batch, one per reading.
+  /// The conservative preimages of a batch, one per reading.
   std::vector<VoxelSet> preimages(const std::vector<Reading>& readings);
-  /// The same, also returning the preimages before dilation in @p raw.
+  /**
+   * @brief The same, also returning the seeding's sample preimages in @p raw: voxel v is in one
+   *        when the 8 samples of h around (centre of v) (+) g take values on both sides of
+   *        [d - b, d + b] or inside it, b = tau + half a cell (not conservative: seeding only;
+   *        a cone reading's is its conservative preimage).
+   */
   std::vector<VoxelSet> preimages(const std::vector<Reading>& readings, std::vector<VoxelSet>& raw);
   /// count[v] = number of sets holding voxel v (at most 255 sets).
   void countField(const std::vector<VoxelSet>& sets, std::vector<std::uint8_t>& count) const;
 
-  /// The count field and the dilated preimages of the last localize() call.
+  /// The count field and the conservative preimages of the last localize() call.
   const std::vector<std::uint8_t>& lastCount() const
   {
     return count_;
@@ -92,7 +93,7 @@ public:
   {
     return sets_;
   }
-  /// The same before dilation (seeding only).
+  /// The seeding's sample preimages and their count (seeding only).
   const std::vector<std::uint8_t>& lastRawCount() const
   {
     return raw_count_;
@@ -101,12 +102,43 @@ public:
   {
     return raw_sets_;
   }
+  /// The seeding's sample preimages dilated by one voxel, and their count (count peaks).
+  const std::vector<std::uint8_t>& lastSeedCount() const
+  {
+    return seed_count_;
+  }
+  const std::vector<VoxelSet>& lastSeedPreimages() const
+  {
+    return seed_sets_;
+  }
   /// OpenMP threads of a call (options.threads, or all cores).
   int threads() const;
   /// Per set: whether it holds @p voxel.
   std::vector<bool> membership(std::size_t voxel, const std::vector<VoxelSet>& sets) const;
 
 private:
+  /// Heading cells [first, first + count) relative to the voxel's heading cell.
+  struct ThetaWindow
+  {
+    int first = 0;
+    int count = 0;
+  };
+  /// What the preimage test of one reading reads: the band and the heading windows.
+  struct PreimagePlan
+  {
+    float lo = 0.0f;  ///< d - tau (no return: max_range - tau) [m]
+    float hi = 0.0f;  ///< d + tau [m]
+    bool no_return = false;
+    ThetaWindow ray;    ///< the cells the sensor headings cover
+    ThetaWindow lower;  ///< the cells any ray of a cone reading may point in
+    ThetaWindow inner;  ///< cells inside every cone of the voxel (count 0: none)
+  };
+  /// False when no voxel can be in the preimage (an offset far outside the grid).
+  bool preimagePlan(const Reading& reading, PreimagePlan& plan) const;
+  void prepareWindows(const std::vector<Reading>& readings);
+  /// The seeding's sample test (not conservative): h - d changes sign among the 8 samples around
+  /// (voxel centre) (+) g, band tau + half a cell.
+  void fillSampleSlice(const Reading& reading, int it, VoxelSet& set) const;
   void fillPreimageSlice(const Reading& reading, int it, VoxelSet& set) const;
   void localizeRobust(const std::vector<Reading>& readings, Result& result);
   void localizeComponentCentres(const std::vector<Reading>& readings, int min_inliers, Result& result);
@@ -115,6 +147,7 @@ private:
   LocalizerOptions options_;
   GridSpec spec_;
   DistanceTable table_;
+  BoundWindows windows_;
   bool prepared_ = false;
   double prepare_seconds_ = 0.0;
   bool prepare_reported_ = false;
@@ -124,6 +157,8 @@ private:
   std::vector<VoxelSet> raw_sets_;
   std::vector<std::uint8_t> count_;
   std::vector<std::uint8_t> raw_count_;  ///< count of the raw preimages (seeding only)
+  std::vector<VoxelSet> seed_sets_;      ///< the raw preimages dilated (seeding only)
+  std::vector<std::uint8_t> seed_count_;
 };
 
 }  // namespace core

@@ -7,6 +7,7 @@
 
 #include "fdml_localization/core/map/polygon_map.h"
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -15,6 +16,21 @@ namespace fdml_localization
 {
 namespace core
 {
+/**
+ * @brief The one float-to-index conversion of the voxel engine: floor(@p value) when it is a
+ *        number with |value| < @p limit (so it fits an int), false otherwise (NaN, inf, huge).
+ * @param limit a bound well inside the int range, e.g. a few grid sizes
+ */
+inline bool floorIndex(double value, double limit, int& index)
+{
+  if (!(std::abs(value) < limit) || !(limit < 1e9))
+  {
+    return false;
+  }
+  index = static_cast<int>(std::floor(value));
+  return true;
+}
+
 /**
  * @brief Geometry of an nx x ny x nt voxel grid over (x, y, theta).
  *

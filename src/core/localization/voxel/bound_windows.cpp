@@ -1,0 +1,137 @@
+#include "fdml_localization/core/localization/voxel/bound_windows.h"
+
+#include <algorithm>
+#include <deque>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace fdml_localization
+{
+namespace core
+{
+namespace
+{
+/// out[j] = op over in[j .. j + m - 1] (indices mod n), O(n) with a monotone deque.
+template <class Better>
+void slidingPeriodic(const std::vector<float>& in, int m, Better better, std::vector<float>& out)
+{
+  const int n = static_cast<int>(in.size());
+  m = std::min(m, n);
+  std::deque<int> window;
+  for (int k = 0; k < n + m - 1; ++k)
+  {
+    const float v = in[k % n];
+    while (!window.empty() && !better(in[window.back() % n], v))
+    {
+      window.pop_back();
+    }
+    window.push_back(k);
+    if (window.front() <= k - m)
+    {
+      window.pop_front();
+    }
+    if (k >= m - 1)
+    {
+      out[k - m + 1] = in[window.front() % n];
+    }
+  }
+}
+
+/// Per padded cell column, the min (or max) over theta cells t .. t + m - 1.
+std::vector<float> alongTheta(const std::vector<float>& src, int nt, int m, bool theta_min)
+{
+  std::vector<float> along(src.size());
+  const std::size_t pslice = src.size() / static_cast<std::size_t>(nt);
+#pragma omp parallel
+  {
+    std::vector<float> in(nt);
+    std::vector<float> out(nt);
+#pragma omp for schedule(static)
+    for (long c = 0; c < static_cast<long>(pslice); ++c)
+    {
+      for (int t = 0; t < nt; ++t)
+      {
+        in[t] = src[t * pslice + c];
+      }
+      if (theta_min)
+      {
+        slidingPeriodic(
+            in, m, [](float a, float b) { return a < b; }, out);
+      }
+      else
+      {
+        slidingPeriodic(
+            in, m, [](float a, float b) { return a > b; }, out);
+      }
+      for (int t = 0; t < nt; ++t)
+      {
+        along[t * pslice + c] = out[t];
+      }
+    }
+  }
+  return along;
+}
+
+/// Min (lower) or max over 2 x 2 padded cells: window (wx, wy) = cells (wx .. wx + 1, wy .. wy + 1).
+std::vector<float> positionWindows(const std::vector<float>& along, const GridSpec& spec, bool lower)
+{
+  const int pnx = spec.nx + 1;
+  const std::size_t pslice = static_cast<std::size_t>(pnx) * (spec.ny + 1);
+  std::vector<float> result(spec.voxelCount());
+#pragma omp parallel for schedule(static)
+  for (int t = 0; t < spec.nt; ++t)
+  {
+    for (int wy = 0; wy < spec.ny; ++wy)
+    {
+      const float* r0 = along.data() + t * pslice + static_cast<std::size_t>(wy) * pnx;
+      const float* r1 = r0 + pnx;
+      float* o = result.data() + spec.index(0, wy, t);
+      for (int wx = 0; wx < spec.nx; ++wx)
+      {
+        o[wx] = lower ? std::min({ r0[wx], r0[wx + 1], r1[wx], r1[wx + 1] }) :
+                        std::max({ r0[wx], r0[wx + 1], r1[wx], r1[wx + 1] });
+      }
+    }
+  }
+  return result;
+}
+}  // namespace
+
+BoundWindows::BoundWindows(CellBounds cells) : cells_(std::move(cells))
+{}
+
+void BoundWindows::require(Kind kind, int m)
+{
+  const auto key = std::make_pair(static_cast<int>(kind), m);
+  if (arrays_.count(key) == 0)
+  {
+    const bool lower = kind == Kind::Lower;
+    const std::vector<float> along =
+        alongTheta(lower ? cells_.lower() : cells_.upper(), cells_.spec().nt, m, kind != Kind::UpperMax);
+    arrays_.emplace(key, positionWindows(along, cells_.spec(), lower));
+  }
+}
+
+const std::vector<float>& BoundWindows::get(Kind kind, int m) const
+{
+  const auto it = arrays_.find(std::make_pair(static_cast<int>(kind), m));
+  if (it == arrays_.end())
+  {
+    throw std::logic_error("BoundWindows: window " + std::to_string(m) + " was not prepared");
+  }
+  return it->second;
+}
+
+std::size_t BoundWindows::memoryBytes() const
+{
+  std::size_t total = cells_.memoryBytes();
+  for (const auto& [key, a] : arrays_)
+  {
+    total += a.capacity() * sizeof(float);
+  }
+  return total;
+}
+
+}  // namespace core
+}  // namespace fdml_localization

@@ -19,6 +19,8 @@ namespace core
 {
 namespace
 {
+/// Leaves of a plateau (spread over it) the final multi-start polishes from.
+constexpr std::size_t kRegionStarts = 12;
 /// Distinct seeds taken from one plateau.
 constexpr std::size_t kSeedsPerPlateau = 3;
 /// ... from plateaus of at least this many leaves (smaller ones give one seed).
@@ -141,6 +143,11 @@ public:
         seed.retry_starts = { found.leaves[cluster.representative].box.centre(),
                               found.leaves[cluster.members[n / 3]].box.centre(),
                               found.leaves[cluster.members[(2 * n) / 3]].box.centre() };
+        const std::size_t spread = std::min(n, kRegionStarts);
+        for (std::size_t j = 0; j < spread; ++j)
+        {
+          seed.region_starts.push_back(found.leaves[cluster.members[j * n / spread]].box.centre());
+        }
         seeds.push_back(std::move(seed));
       }
     }

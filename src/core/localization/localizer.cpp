@@ -2,6 +2,7 @@
 
 #include "fdml_localization/core/geometry/cone_cast.h"
 #include "fdml_localization/core/localization/adaptive/adaptive_engine.h"
+#include "fdml_localization/core/localization/certificate.h"
 
 #include "fdml_localization/core/localization/voxel/voxel_engine.h"
 
@@ -210,7 +211,14 @@ void Localizer::prepare()
 Result Localizer::localize(const std::vector<Reading>& readings)
 {
   validateReadings(readings, options_);
-  return engine_->localize(readings);
+  Result result = engine_->localize(readings);
+  if (const VoxelEngine* voxel = dynamic_cast<const VoxelEngine*>(engine_.get()))
+  {
+    // The voxel engine's count field, whose maximum bounds the consensus where its preimage
+    // test is conservative (the adaptive engine certifies its own answer).
+    certifyVoxels(*map_, readings, options_.range_tolerance, voxel->grid(), voxel->lastCount(), result);
+  }
+  return result;
 }
 
 }  // namespace core

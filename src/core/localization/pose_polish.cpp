@@ -81,8 +81,9 @@ ResidualRow rayRow(const MapRayCaster& map, const Pose2& q, const Rotation& rq, 
   return row;
 }
 
-/// A cone reading: central differences of the exact cone cast. Where the nearest point lies
-/// strictly inside the sector the heading derivative vanishes (the reading does not fix it).
+/// A cone reading: forward differences of the exact cone cast (backward where the forward step
+/// leaves free space). Where the nearest point lies strictly inside the sector the heading
+/// derivative vanishes (the reading does not fix it).
 ResidualRow coneRow(const MapRayCaster& map, const Pose2& q, const Reading& reading)
 {
   ResidualRow row;
@@ -99,16 +100,14 @@ ResidualRow coneRow(const MapRayCaster& map, const Pose2& q, const Reading& read
   row.r = h - reading.range;
   for (int axis = 0; axis < 3; ++axis)
   {
-    const double e[3] = { axis == 0 ? kConeStep : 0.0, axis == 1 ? kConeStep : 0.0, axis == 2 ? kConeStep : 0.0 };
-    const double plus = cone(e[0], e[1], e[2]);
-    const double minus = cone(-e[0], -e[1], -e[2]);
-    if (std::isfinite(plus) && std::isfinite(minus))
+    for (const double step : { kConeStep, -kConeStep })
     {
-      row.jacobian(axis) = (plus - minus) / (2.0 * kConeStep);
-    }
-    else if (std::isfinite(plus) || std::isfinite(minus))
-    {
-      row.jacobian(axis) = std::isfinite(plus) ? (plus - h) / kConeStep : (h - minus) / kConeStep;
+      const double shifted = cone(axis == 0 ? step : 0.0, axis == 1 ? step : 0.0, axis == 2 ? step : 0.0);
+      if (std::isfinite(shifted))
+      {
+        row.jacobian(axis) = (shifted - h) / step;
+        break;
+      }
     }
   }
   return row;

@@ -3,6 +3,7 @@
 // apartment and the office. The truth explains every reading exactly, so it must be among the
 // candidates (5 cm, 2 deg) in every trial, with either engine, and the best candidate, when it
 // is the truth's, must lie within 1 cm and 0.5 deg of it.
+#include "fdml_localization/core/localization/certificate.h"
 #include "fdml_localization/core/localization/localizer.h"
 #include "fdml_localization/core/localization/robust_search.h"
 
@@ -105,8 +106,12 @@ bool onContinuum(const Candidate& candidate, const Pose2& truth, const Eigen::Ve
 struct MissCount
 {
   int trials = 0;
-  int missed = 0;      ///< no candidate within 5 cm and 2 deg
-  int inaccurate = 0;  ///< the best candidate is the truth's but beyond 1 cm or 0.5 deg
+  int missed = 0;        ///< no candidate within 5 cm and 2 deg
+  int inaccurate = 0;    ///< the best candidate is the truth's but beyond 1 cm or 0.5 deg
+  int contradicted = 0;  ///< certificates the truth contradicts
+  int complete = 0;      ///< complete certificates
+  int excluded = 0;      ///< regions at the bound proved empty
+  int regions = 0;       ///< regions at the bound
 };
 
 MissCount runDriving(const std::string& map_file, Engine engine, int trials, std::uint64_t seed)
@@ -124,6 +129,16 @@ MissCount runDriving(const std::string& map_file, Engine engine, int trials, std
     const std::vector<Reading> readings = test::exactReadings(*map, truth, offsets);
     const Result result = localizer.localize(readings);
     ++count.trials;
+    // The truth explains every reading: no bound below that holds, and a complete certificate
+    // claims every pose reaching the bound lies in a candidate's region (the truth's too).
+    const Certificate& certificate = result.certificate;
+    count.complete += certificate.complete ? 1 : 0;
+    count.excluded += certificate.regions_excluded;
+    count.regions += certificate.regions_at_bound;
+    if (certificate.max_consensus_bound < consensusWithin(*map, truth, readings, options.range_tolerance))
+    {
+      ++count.contradicted;
+    }
     const Eigen::Vector3d null = undeterminedDirection(*map, truth, readings);
     if (std::any_of(result.candidates.begin(), result.candidates.end(),
                     [&](const Candidate& c) { return onContinuum(c, truth, null, 20); }))
@@ -165,6 +180,9 @@ TEST_P(NeverMiss, FourSensorsDriving)
   const MissCount count = runDriving(std::get<0>(GetParam()), std::get<1>(GetParam()), 20, 16);
   EXPECT_EQ(count.missed, 0) << "of " << count.trials;
   EXPECT_EQ(count.inaccurate, 0) << "of " << count.trials;
+  EXPECT_EQ(count.contradicted, 0) << "of " << count.trials;
+  std::printf("complete certificates: %d of %d; regions at the bound %d, %d of them excluded\n", count.complete,
+              count.trials, count.regions, count.excluded);
 }
 
 INSTANTIATE_TEST_SUITE_P(Maps, NeverMiss,

@@ -2,6 +2,7 @@
 // shared robust search (seed_search.h), or verified component centres (paper, baseline).
 #include "fdml_localization/core/localization/adaptive/adaptive_engine.h"
 
+#include "fdml_localization/core/localization/certificate.h"
 #include "fdml_localization/core/localization/ranking.h"
 #include "fdml_localization/core/localization/robust_search.h"
 #include "fdml_localization/core/localization/seed_search.h"
@@ -196,6 +197,8 @@ Result AdaptiveEngine::localize(const std::vector<Reading>& readings)
   }
   result.boxes_per_level = search.result().boxes_per_level;
   result.truncated = search.result().truncated;
+  const std::int64_t theta_cells = std::max<std::int64_t>(1, std::llround(kTwoPi / cell_theta_));
+  certifyAdaptive(*map_, readings, options_.range_tolerance, search, theta_cells, result);
   last_leaves_ = search.result().leaves;
   result.times.total = secondsSince(start);
   return result;

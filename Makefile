@@ -1,13 +1,14 @@
 # fdml_localization: the two commands.
 #   make test   install what is missing, build in a private catkin workspace, run every test
 #   make demo   install, build, and run the headless kidnapped-robot demo (RVIZ=1 opens rviz)
-# Other targets: make deps | build | bench | clean
+# Other targets: make deps | build | bench | verify | clean
+#   make verify  the whole verification suite (scripts/verify.sh; figures in docs/BENCHMARKS.md)
 SHELL := /bin/bash
 WS ?= $(CURDIR)/ws
 RVIZ ?= 0
 export WS
 
-.PHONY: all deps build test demo bench clean
+.PHONY: all deps build test demo bench verify clean
 
 all: build
 
@@ -25,6 +26,9 @@ demo: build
 
 bench: build
 	@bash scripts/bench.sh
+
+verify: build
+	@bash scripts/verify.sh
 
 clean:
 	rm -rf $(WS)

@@ -7,9 +7,7 @@
 #include "fdml_localization/core/localization/localizer.h"
 #include "fdml_localization/core/localization/robust_search.h"
 
-#include <Eigen/SVD>
-
-#include "localizer_test_utils.h"
+#include "verification_trials.h"
 
 #include <gtest/gtest.h>
 
@@ -58,32 +56,6 @@ Pose2 drivingPose(const MapRayCaster& map, const std::vector<Pose2>& offsets, st
       return truth;
     }
   }
-}
-
-/**
- * The direction (x, y, theta) along which the readings do not determine the pose at @p truth
- * (the right singular vector of the ranges' Jacobian with a singular value below 1e-3 of the
- * largest), or zero when they determine it.
- */
-Eigen::Vector3d undeterminedDirection(const MapRayCaster& map, const Pose2& truth, const std::vector<Reading>& readings)
-{
-  const double step = 1e-5;
-  Eigen::MatrixXd jacobian(readings.size(), 3);
-  for (int axis = 0; axis < 3; ++axis)
-  {
-    Pose2 plus = truth;
-    Pose2 minus = truth;
-    (axis == 0 ? plus.x : axis == 1 ? plus.y : plus.theta) += step;
-    (axis == 0 ? minus.x : axis == 1 ? minus.y : minus.theta) -= step;
-    for (std::size_t i = 0; i < readings.size(); ++i)
-    {
-      jacobian(i, axis) =
-          (map.range(compose(plus, readings[i].offset)) - map.range(compose(minus, readings[i].offset))) / (2.0 * step);
-    }
-  }
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(jacobian, Eigen::ComputeThinV);
-  const Eigen::Vector3d s = svd.singularValues();
-  return s(2) < 1e-3 * s(0) ? Eigen::Vector3d(svd.matrixV().col(2)) : Eigen::Vector3d::Zero();
 }
 
 /// True when @p candidate explains every reading exactly and lies from @p truth along the
@@ -139,7 +111,7 @@ MissCount runDriving(const std::string& map_file, Engine engine, int trials, std
     {
       ++count.contradicted;
     }
-    const Eigen::Vector3d null = undeterminedDirection(*map, truth, readings);
+    const Eigen::Vector3d null = verification::undeterminedDirection(*map, truth, readings);
     if (std::any_of(result.candidates.begin(), result.candidates.end(),
                     [&](const Candidate& c) { return onContinuum(c, truth, null, 20); }))
     {

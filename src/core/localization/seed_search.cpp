@@ -167,8 +167,9 @@ public:
     }
   }
 
-  /// The candidates explaining at least @p level readings, ranked, each polished from a lattice
-  /// around it (multi-start) so that it reaches its region's optimum, with their seeds' regions.
+  /// The candidates explaining at least @p level readings, ranked, those tied at the best net
+  /// consensus polished from their region's poses and a lattice around them (multi-start) so
+  /// that they reach their region's optimum, with their seeds' regions.
   SeedSearchOutcome ranked(int level, const LocalizerOptions& options)
   {
     std::vector<Candidate> kept;
@@ -185,9 +186,17 @@ public:
                               options.max_candidates);
     RefinementSettings with = levelSettings(level);
     with.multi_start = 1;
+    // The candidates tied at the best net consensus (those the answer rests on) get the
+    // multi-start; every candidate gets its covariance widened along continua.
+    const int top = kept.empty() ? 0 : netConsensus(kept.front());
 #pragma omp parallel for schedule(dynamic, 1) num_threads(ctx_.threads) if (kept.size() >= 2)
     for (std::size_t j = 0; j < kept.size(); ++j)
     {
+      if (netConsensus(kept[j]) < top)
+      {
+        widenAlongContinua(ctx_.map, ctx_.readings, ctx_.settings.noise_sigma, kept[j]);
+        continue;
+      }
       const SearchSeed& seed = seeds_[static_cast<std::size_t>(kept[j].support)];
       Candidate polished = refineSeed(ctx_.map, kept[j].pose, ctx_.readings, seed.hypothesis, with,
                                       seed.region_starts.empty() ? seed.retry_starts : seed.region_starts);

@@ -260,6 +260,49 @@ inline const char* contradicts(const MapRayCaster& map, const Trial& trial, cons
   return nullptr;
 }
 
+/// The checks of a noise-free trial: the truth among the candidates (or, where the readings
+/// leave the pose undetermined, the maximum consensus reached) and the best candidate accurate.
+inline void checkNoiseFree(const Localizer& localizer, const Trial& trial, const Result& result,
+                           const std::string& label, Figures& figures)
+{
+  const MapRayCaster& map = localizer.map();
+  const auto truths = std::find_if(result.candidates.begin(), result.candidates.end(),
+                                   [&](const Candidate& c) { return isTruths(c, trial.truth); });
+  const Candidate at_truth =
+      verifiedCandidate(map, trial.truth, trial.readings, localizer.options().agreement_tolerance);
+  if (!undeterminedDirection(map, trial.truth, trial.readings).isZero())
+  {
+    // A continuum of poses explains the readings: the best candidate must explain as many.
+    ++figures.undetermined;
+    if (result.candidates.empty() || netConsensus(at_truth) > netConsensus(result.candidates.front()))
+    {
+      ++figures.missed;
+      figures.failures.push_back(std::string("maximum consensus missed (undetermined pose): ") + label);
+    }
+    return;
+  }
+  if (truths == result.candidates.end())
+  {
+    // Not a miss when the list is full of candidates at least as good as the truth (ties).
+    const bool tied_out = static_cast<int>(result.candidates.size()) >= localizer.options().max_candidates &&
+                          !betterCandidate(at_truth, result.candidates.back());
+    if (!tied_out)
+    {
+      ++figures.missed;
+      figures.failures.push_back(std::string("truth missed: ") + label);
+    }
+    return;
+  }
+  if (truths == result.candidates.begin() &&
+      (test::positionError(truths->pose, trial.truth) > 0.01 ||
+       test::angleError(truths->pose, trial.truth) > 0.5 * kDeg) &&
+      truths->rms_residual > 1e-6)
+  {
+    ++figures.inaccurate;
+    figures.failures.push_back(std::string("best candidate inaccurate: ") + label);
+  }
+}
+
 /// Runs one trial on @p localizer and adds it to @p figures.
 inline void runTrial(Localizer& localizer, const Trial& trial, int reference_samples, std::mt19937_64& rng,
                      Figures& figures)
@@ -286,47 +329,10 @@ inline void runTrial(Localizer& localizer, const Trial& trial, int reference_sam
       figures.failures.push_back(std::string("certificate contradicted (") + why + "): " + label);
     }
   }
-  if (trial.noisy)
+  if (!trial.noisy)
   {
-    return;
-  }
-  ++figures.noise_free;
-  const auto truths = std::find_if(result.candidates.begin(), result.candidates.end(),
-                                   [&](const Candidate& c) { return isTruths(c, trial.truth); });
-  const Candidate at_truth =
-      verifiedCandidate(map, trial.truth, trial.readings, localizer.options().agreement_tolerance);
-  if (!undeterminedDirection(map, trial.truth, trial.readings).isZero())
-  {
-    // A continuum of poses explains the readings: the best candidate must explain as many.
-    ++figures.undetermined;
-    if (result.candidates.empty() || netConsensus(at_truth) > netConsensus(result.candidates.front()))
-    {
-      ++figures.missed;
-      figures.failures.push_back(std::string("maximum consensus missed (undetermined pose): ") + label);
-    }
-    return;
-  }
-  if (truths == result.candidates.end())
-  {
-    // Not a miss when the list is full of candidates at least as good as the truth (ties).
-    const Candidate at_truth =
-        verifiedCandidate(map, trial.truth, trial.readings, localizer.options().agreement_tolerance);
-    const bool tied_out = static_cast<int>(result.candidates.size()) >= localizer.options().max_candidates &&
-                          !betterCandidate(at_truth, result.candidates.back());
-    if (!tied_out)
-    {
-      ++figures.missed;
-      figures.failures.push_back(std::string("truth missed: ") + label);
-    }
-    return;
-  }
-  if (truths == result.candidates.begin() &&
-      (test::positionError(truths->pose, trial.truth) > 0.01 ||
-       test::angleError(truths->pose, trial.truth) > 0.5 * kDeg) &&
-      truths->rms_residual > 1e-6)
-  {
-    ++figures.inaccurate;
-    figures.failures.push_back(std::string("best candidate inaccurate: ") + label);
+    ++figures.noise_free;
+    checkNoiseFree(localizer, trial, result, label, figures);
   }
 }
 

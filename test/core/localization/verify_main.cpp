@@ -69,6 +69,28 @@ void print(const char* name, const verification::Figures& f)
               f.trials ? 100.0 * f.complete / f.trials : 0.0, f.trials ? 100.0 * f.top1 / f.trials : 0.0,
               f.trials ? 1000.0 * f.seconds / f.trials : 0.0);
 }
+LocalizerOptions options(Engine engine, int resolution)
+{
+  LocalizerOptions o;
+  o.engine = engine;
+  o.resolution = resolution;
+  o.threads = 1;
+  return o;
+}
+
+void add(const verification::Figures& one, verification::Figures& f)
+{
+  f.trials += one.trials;
+  f.noise_free += one.noise_free;
+  f.undetermined += one.undetermined;
+  f.missed += one.missed;
+  f.inaccurate += one.inaccurate;
+  f.contradicted += one.contradicted;
+  f.far_optima += one.far_optima;
+  f.complete += one.complete;
+  f.top1 += one.top1;
+  f.seconds += one.seconds;
+}
 }  // namespace
 
 int main(int argc, char** argv)
@@ -85,11 +107,8 @@ int main(int argc, char** argv)
   {
     for (const auto& map : maps)
     {
-      LocalizerOptions options;
-      options.engine = e == 0 ? Engine::Voxel : Engine::Adaptive;
-      options.resolution = args.resolution;
-      options.threads = 1;
-      localizers[e].push_back(std::make_unique<Localizer>(map, options));
+      localizers[e].push_back(
+          std::make_unique<Localizer>(map, options(e == 0 ? Engine::Voxel : Engine::Adaptive, args.resolution)));
     }
   }
   std::mt19937_64 rng(args.seed);
@@ -108,19 +127,8 @@ int main(int argc, char** argv)
     {
       verification::Figures one;
       verification::runTrial(*localizers[e][static_cast<std::size_t>(trial.map)], trial, 300, rng, one);
-      for (verification::Figures* f : { &total[e], &by_geometry[e][trial.geometry] })
-      {
-        f->trials += one.trials;
-        f->noise_free += one.noise_free;
-        f->undetermined += one.undetermined;
-        f->missed += one.missed;
-        f->inaccurate += one.inaccurate;
-        f->contradicted += one.contradicted;
-        f->far_optima += one.far_optima;
-        f->complete += one.complete;
-        f->top1 += one.top1;
-        f->seconds += one.seconds;
-      }
+      add(one, total[e]);
+      add(one, by_geometry[e][trial.geometry]);
       for (const std::string& failure : one.failures)
       {
         std::printf("FAIL %s: %s\n", e == 0 ? "voxel" : "adaptive", failure.c_str());

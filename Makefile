@@ -1,7 +1,8 @@
 # fdml_localization: the two commands.
 #   make test   install what is missing, build in a private catkin workspace, run every test
 #   make demo   install, build, and run the headless kidnapped-robot demo (RVIZ=1 opens rviz)
-# Other targets: make deps | build | bench | fuzz | test-asan | clean
+# Other targets: make deps | build | bench | verify | fuzz | test-asan | clean
+#   make verify     the whole verification suite (scripts/verify.sh; figures in docs/BENCHMARKS.md)
 #   make fuzz       the fuzz suite at full size (FUZZ_CASES cases, default 100000; docs/BENCHMARKS.md)
 #   make test-asan  unit tests and the fuzz suite under AddressSanitizer + UBSan (workspace ws-asan/)
 SHELL := /bin/bash
@@ -9,7 +10,7 @@ WS ?= $(CURDIR)/ws
 RVIZ ?= 0
 export WS
 
-.PHONY: all deps build test demo bench fuzz test-asan clean
+.PHONY: all deps build test demo bench verify fuzz test-asan clean
 
 all: build
 
@@ -27,6 +28,9 @@ demo: build
 
 bench: build
 	@bash scripts/bench.sh
+
+verify: build
+	@bash scripts/verify.sh
 
 fuzz: deps
 	@bash scripts/fuzz.sh

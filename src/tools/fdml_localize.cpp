@@ -204,6 +204,12 @@ void printTimes(const core::Result& result)
                result.min_inliers_used, result.readings_used, result.candidates.size(), 1e3 * t.table,
                1e3 * t.preimages, 1e3 * t.count, 1e3 * t.components, 1e3 * t.verification, 1e3 * t.polish,
                1e3 * t.total);
+  const core::Certificate& c = result.certificate;
+  std::fprintf(stderr,
+               "certificate: no pose explains more than %d readings within the range tolerance; best candidate %d; "
+               "regions at the bound %d (covered %d, excluded %d); complete %s\n",
+               c.max_consensus_bound, c.best_consensus, c.regions_at_bound, c.regions_covered, c.regions_excluded,
+               c.complete ? "yes" : "no");
 }
 }  // namespace
 

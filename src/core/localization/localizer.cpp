@@ -3,6 +3,7 @@
 #include "fdml_localization/core/geometry/cone_cast.h"
 #include "fdml_localization/core/localization/adaptive/adaptive_engine.h"
 #include "fdml_localization/core/localization/no_return.h"
+#include "fdml_localization/core/localization/certificate.h"
 
 #include "fdml_localization/core/localization/voxel/voxel_engine.h"
 
@@ -214,14 +215,21 @@ void Localizer::prepare()
 Result Localizer::localize(const std::vector<Reading>& readings)
 {
   validateReadings(readings, options_);
-  if (options_.no_return == NoReturnPolicy::Constraint)
-  {
-    return engine_->localize(readings);
-  }
+  const bool all = options_.no_return == NoReturnPolicy::Constraint;
   std::vector<std::size_t> kept;
-  const std::vector<Reading> returns = readingsWithReturn(readings, options_, &kept);
-  Result result = engine_->localize(returns);
-  restoreNoReturns(&result, readings, kept, options_, *map_);
+  const std::vector<Reading> searched = all ? readings : readingsWithReturn(readings, options_, &kept);
+  Result result = engine_->localize(searched);
+  if (const VoxelEngine* voxel = dynamic_cast<const VoxelEngine*>(engine_.get()))
+  {
+    // The voxel engine's count field, whose maximum bounds the consensus where its preimage
+    // test is conservative (the adaptive engine certifies its own answer). Under the weak and
+    // drop no-return policies the certificate speaks of the readings with a return.
+    certifyVoxels(*map_, searched, options_.range_tolerance, voxel->grid(), voxel->lastCount(), result);
+  }
+  if (!all)
+  {
+    restoreNoReturns(&result, readings, kept, options_, *map_);
+  }
   return result;
 }
 

@@ -1,4 +1,8 @@
+// The continuous polish: Levenberg-Marquardt on (x, y, theta) over the exact ray cast (analytic
+// derivative) or the exact cone cast (numeric derivative), with a covariance estimate.
 #include "fdml_localization/core/localization/robust_search.h"
+
+#include "fdml_localization/core/geometry/cone_cast.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
@@ -14,6 +18,8 @@ namespace
 {
 /// Residual [m] charged to a ray that leaves free space or misses, during the polish.
 constexpr double kPenaltyResidual = 1.0;
+/// Step of the numeric derivative of a cone reading [m] and [rad].
+constexpr double kConeStep = 1e-6;
 
 /// One reading's residual and its derivative with respect to (x, y, theta).
 struct ResidualRow
@@ -32,8 +38,9 @@ struct Rotation
   {}
 };
 
-ResidualRow residualRow(const MapRayCaster& map, const Pose2& q, const Rotation& rq, const Reading& reading,
-                        const Rotation& rg)
+/// A ray reading: the hit edge's normal gives the derivative of the range.
+ResidualRow rayRow(const MapRayCaster& map, const Pose2& q, const Rotation& rq, const Reading& reading,
+                   const Rotation& rg)
 {
   ResidualRow row;
   const double c = rq.c;
@@ -74,6 +81,38 @@ ResidualRow residualRow(const MapRayCaster& map, const Pose2& q, const Rotation&
   return row;
 }
 
+/// A cone reading: forward differences of the exact cone cast (backward where the forward step
+/// leaves free space). Where the nearest point lies strictly inside the sector the heading
+/// derivative vanishes (the reading does not fix it).
+ResidualRow coneRow(const MapRayCaster& map, const Pose2& q, const Reading& reading)
+{
+  ResidualRow row;
+  auto cone = [&](double dx, double dy, double dt) {
+    const Pose2 sensor = compose(Pose2(q.x + dx, q.y + dy, q.theta + dt), reading.offset);
+    return map.isFree(sensor.position()) ? coneRange(map, sensor, reading.half_angle) : kInf;
+  };
+  const double h = cone(0.0, 0.0, 0.0);
+  if (!std::isfinite(h))
+  {
+    return row;
+  }
+  row.valid = true;
+  row.r = h - reading.range;
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    for (const double step : { kConeStep, -kConeStep })
+    {
+      const double shifted = cone(axis == 0 ? step : 0.0, axis == 1 ? step : 0.0, axis == 2 ? step : 0.0);
+      if (std::isfinite(shifted))
+      {
+        row.jacobian(axis) = (shifted - h) / step;
+        break;
+      }
+    }
+  }
+  return row;
+}
+
 struct System
 {
   double cost = 0.0;
@@ -95,7 +134,8 @@ System buildSystem(const MapRayCaster& map, const Pose2& q, const std::vector<Re
     {
       continue;
     }
-    const ResidualRow row = residualRow(map, q, rq, readings[i], mounts[i]);
+    const ResidualRow row =
+        readings[i].half_angle > 0.0 ? coneRow(map, q, readings[i]) : rayRow(map, q, rq, readings[i], mounts[i]);
     ++sys.used;
     if (!row.valid)
     {
@@ -126,6 +166,28 @@ Pose2 step(const Pose2& q, const Eigen::Vector3d& delta)
 {
   return Pose2(q.x + delta(0), q.y + delta(1), wrapAngle(q.theta + delta(2)));
 }
+
+/**
+ * The covariance of (x, y, theta): sigma^2 (J^T J)^-1 where the readings determine the pose, with
+ * a weak prior (a standard deviation of the map's diagonal in x, y and of pi in theta) so that a
+ * direction the readings leave undetermined (a corridor, a cone facing a flat wall) gets about
+ * the prior's large variance along it instead of a false precision or an arbitrary constant.
+ */
+Eigen::Matrix3d poseCovariance(const MapRayCaster& map, const System& sys, double noise_sigma)
+{
+  const int dof = sys.used - 3;
+  double sigma2 = noise_sigma * noise_sigma;
+  if (dof > 0)
+  {
+    sigma2 = std::max(sigma2, sys.sum_sq / dof);
+  }
+  const double extent = std::max(map.map().bounds().size().norm(), 1.0);
+  Eigen::Matrix3d information = sys.jtj / sigma2;
+  information.diagonal() += Eigen::Vector3d(1.0 / (extent * extent), 1.0 / (extent * extent), 1.0 / (kPi * kPi));
+  Eigen::Matrix3d covariance = information.inverse();
+  covariance = 0.5 * (covariance + covariance.transpose());
+  return covariance.allFinite() ? covariance : Eigen::Matrix3d::Identity() * 1e6;
+}
 }  // namespace
 
 PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std::vector<Reading>& readings,
@@ -141,7 +203,7 @@ PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std:
   }
   System sys = buildSystem(map, out.pose, readings, mounts, use, robust_scale);
   double lambda = 1e-3;
-  for (int iter = 0; iter < max_iterations; ++iter)
+  for (int iter = 0; iter < max_iterations && lambda <= 1e8; ++iter)
   {
     out.iterations = iter + 1;
     Eigen::Matrix3d a = sys.h;
@@ -151,49 +213,24 @@ PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std:
     {
       break;
     }
-    // Keep each step local: the ray-cast model only holds near the current pose.
-    const double max_shift = 0.5;
-    const double max_turn = 0.3;
-    const double shift = delta.head<2>().norm();
-    const double scale = std::max({ 1.0, shift / max_shift, std::abs(delta(2)) / max_turn });
-    delta /= scale;
+    // Keep each step local: the model only holds near the current pose (0.5 m, 0.3 rad).
+    delta /= std::max({ 1.0, delta.head<2>().norm() / 0.5, std::abs(delta(2)) / 0.3 });
     const Pose2 trial = step(out.pose, delta);
     const System next = buildSystem(map, trial, readings, mounts, use, robust_scale);
-    if (next.cost < sys.cost)
-    {
-      out.pose = trial;
-      sys = next;
-      lambda = std::max(lambda / 3.0, 1e-9);
-      if (delta.head<2>().norm() < 1e-8 && std::abs(delta(2)) < 1e-9)
-      {
-        break;
-      }
-    }
-    else
+    if (next.cost >= sys.cost)
     {
       lambda *= 4.0;
-      if (lambda > 1e8)
-      {
-        break;
-      }
+      continue;
+    }
+    out.pose = trial;
+    sys = next;
+    lambda = std::max(lambda / 3.0, 1e-9);
+    if (delta.head<2>().norm() < 1e-8 && std::abs(delta(2)) < 1e-9)
+    {
+      break;
     }
   }
-  const System final_sys = buildSystem(map, out.pose, readings, mounts, use, 0.0);
-  const int dof = final_sys.used - 3;
-  double sigma2 = noise_sigma * noise_sigma;
-  if (dof > 0)
-  {
-    sigma2 = std::max(sigma2, final_sys.sum_sq / dof);
-  }
-  Eigen::FullPivLU<Eigen::Matrix3d> lu(final_sys.jtj);
-  if (lu.rank() == 3)
-  {
-    out.covariance = sigma2 * lu.inverse();
-  }
-  else
-  {
-    out.covariance = Eigen::Matrix3d::Identity() * 1e6;
-  }
+  out.covariance = poseCovariance(map, buildSystem(map, out.pose, readings, mounts, use, 0.0), noise_sigma);
   return out;
 }
 

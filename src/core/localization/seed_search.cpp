@@ -74,6 +74,18 @@ public:
       const Pose2& start = seeds_[c].start;
       candidates_[c] = verifiedCandidate(ctx_.map, start, ctx_.readings, ctx_.settings.agreement_tolerance);
       rough_[c] = evaluatePose(ctx_.map, start, ctx_.readings, ctx_.loose_gate).inliers;
+      // Near a depth discontinuity (a ray grazing a corner) a few centimetres change a range
+      // by metres: the region's other poses may agree where its centre does not. Start where
+      // the most readings roughly agree.
+      for (const Pose2& other : seeds_[c].retry_starts)
+      {
+        const int rough = evaluatePose(ctx_.map, other, ctx_.readings, ctx_.loose_gate).inliers;
+        if (rough > rough_[c])
+        {
+          rough_[c] = rough;
+          seeds_[c].start = other;
+        }
+      }
     }
   }
 
@@ -126,21 +138,22 @@ public:
    *        get a local lattice search and restarts from other poses of their region; a fixed
    *        number, so the result does not depend on thread timing.
    */
-  void retryFor(int level)
+  void retryFor(int level, std::size_t retried = kRetriedSeeds, std::size_t searched = kLocallySearchedSeeds)
   {
-    const std::vector<long> order = retryOrder(level);
+    const std::vector<long> order = retryOrder(level, retried);
     const RefinementSettings with = levelSettings(level);
     RefinementSettings search = with;
     search.local_search_cells = 2;
     search.local_search_step = 0.5 * ctx_.scale.cell_xy;
     search.local_search_angle_step = 0.5 * ctx_.scale.cell_theta;
+    search.multi_start = 1;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(ctx_.threads) if (order.size() >= 2)
     for (std::size_t j = 0; j < order.size(); ++j)
     {
       const long c = order[j];
       retried_[c] = 1;
       const SearchSeed& seed = seeds_[c];
-      if (j < kLocallySearchedSeeds)
+      if (j < searched)
       {
         keepBetter(c, refineSeed(ctx_.map, seed.start, ctx_.readings, seed.hypothesis, search));
       }
@@ -154,7 +167,9 @@ public:
     }
   }
 
-  /// The candidates explaining at least @p level readings, ranked, with their seeds' regions.
+  /// The candidates explaining at least @p level readings, ranked, those tied at the best net
+  /// consensus polished from their region's poses and a lattice around them (multi-start) so
+  /// that they reach their region's optimum, with their seeds' regions.
   SeedSearchOutcome ranked(int level, const LocalizerOptions& options)
   {
     std::vector<Candidate> kept;
@@ -166,6 +181,31 @@ public:
         candidates_[c].support = static_cast<double>(c);
         kept.push_back(std::move(candidates_[c]));
       }
+    }
+    kept = rankAndDeduplicate(std::move(kept), options.uniqueness_distance, options.uniqueness_angle,
+                              options.max_candidates);
+    RefinementSettings with = levelSettings(level);
+    with.multi_start = 1;
+    // The candidates tied at the best net consensus (those the answer rests on) get the
+    // multi-start; every candidate gets its covariance widened along continua.
+    const int top = kept.empty() ? 0 : netConsensus(kept.front());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(ctx_.threads) if (kept.size() >= 2)
+    for (std::size_t j = 0; j < kept.size(); ++j)
+    {
+      if (netConsensus(kept[j]) < top)
+      {
+        widenAlongContinua(ctx_.map, ctx_.readings, ctx_.settings.noise_sigma, kept[j]);
+        continue;
+      }
+      const SearchSeed& seed = seeds_[static_cast<std::size_t>(kept[j].support)];
+      Candidate polished = refineSeed(ctx_.map, kept[j].pose, ctx_.readings, seed.hypothesis, with,
+                                      seed.region_starts.empty() ? seed.retry_starts : seed.region_starts);
+      if (betterCandidate(polished, kept[j]))
+      {
+        polished.support = kept[j].support;
+        kept[j] = std::move(polished);
+      }
+      widenAlongContinua(ctx_.map, ctx_.readings, ctx_.settings.noise_sigma, kept[j]);
     }
     SeedSearchOutcome outcome;
     outcome.min_inliers_used = level;
@@ -181,7 +221,7 @@ public:
   }
 
 private:
-  std::vector<long> retryOrder(int level) const
+  std::vector<long> retryOrder(int level, std::size_t retried) const
   {
     std::vector<long> order;
     for (long c = 0; c < static_cast<long>(seeds_.size()); ++c)
@@ -194,7 +234,7 @@ private:
     std::stable_sort(order.begin(), order.end(), [&](long a, long b) {
       return seeds_[a].promised != seeds_[b].promised ? seeds_[a].promised > seeds_[b].promised : rough_[a] > rough_[b];
     });
-    order.resize(std::min(order.size(), kRetriedSeeds));
+    order.resize(std::min(order.size(), retried));
     return order;
   }
 
@@ -232,6 +272,8 @@ SearchContext makeContext(const MapRayCaster& map, const std::vector<Reading>& r
   ctx.settings.noise_sigma = std::max(options.range_tolerance / std::sqrt(3.0), 1e-4);
   ctx.settings.seed_position_error = 1.5 * scale.cell_xy;
   ctx.settings.seed_angle_error = scale.cell_theta;
+  ctx.settings.multi_start_step = scale.cell_xy;
+  ctx.settings.multi_start_angle_step = scale.cell_theta;
   // Seeds where fewer than (level - 2) readings agree even this loosely are not polished.
   ctx.loose_gate = seedGate(readings, options, scale);
   return ctx;

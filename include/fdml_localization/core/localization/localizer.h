@@ -152,6 +152,37 @@ struct StageTimes
   double total = 0.0;
 };
 
+/**
+ * @brief What the search proved about its answer (certificate.h). Every figure counts the
+ *        readings a pose explains within the range tolerance tau (LocalizerOptions::
+ *        range_tolerance): |h - d| <= tau, the sensor in free space, a no-return reading when
+ *        nothing in range is nearer than max_range - tau. Poses are those of the searched space
+ *        (the map's bounding box x [-pi, pi), the robot's base in free space).
+ */
+struct Certificate
+{
+  /// Proved upper bound: no pose explains more readings than this. It comes from the search's
+  /// conservative tests (the adaptive engine's largest leaf or set-aside box count, the voxel
+  /// count field's maximum). -1 = no bound (the engine proves none).
+  int max_consensus_bound = -1;
+  /// Readings the best candidate explains (0 without candidates). Equal to the bound: the bound
+  /// is attained, the maximum consensus is proved.
+  int best_consensus = 0;
+  /// Connected regions of boxes (voxels) whose count reaches the bound: every pose that may
+  /// explain max_consensus_bound readings lies in one of them.
+  int regions_at_bound = 0;
+  /// ... of which hold a returned candidate.
+  int regions_covered = 0;
+  /// ... of which hold none but were proved empty: a finer subdivision of their boxes with the
+  /// same conservative test left no box that may reach the bound.
+  int regions_excluded = 0;
+  /// best_consensus == max_consensus_bound, every region at the bound covered or excluded, and
+  /// no box that may reach the bound left unresolved by a search budget: the best candidate
+  /// explains the most readings any pose can, and every pose that can is in the region of a
+  /// returned candidate.
+  bool complete = false;
+};
+
 /// The outcome of one localize() call.
 struct Result
 {
@@ -163,6 +194,7 @@ struct Result
   std::vector<long> boxes_per_level;  ///< adaptive engine: boxes kept at each level
   Engine engine = Engine::Voxel;
   Method method = Method::Robust;
+  Certificate certificate;  ///< what the search proved (see Certificate)
 };
 
 /// The engine interface behind Localizer.

@@ -33,8 +33,16 @@ struct PoseEvaluation
 };
 
 /**
+ * @brief The reading @p reading predicts from sensor pose @p sensor: the exact ray cast for a
+ *        ray (half_angle 0), the exact cone cast (cone_cast.h) for a cone; +inf when nothing lies
+ *        within @p max_range [m].
+ */
+double predictedRange(const MapRayCaster& map, const Pose2& sensor, const Reading& reading, double max_range);
+
+/**
  * @brief Verifies @p pose: reading i agrees when its sensor position q (+) g_i is in free
- *        space and |h(q (+) g_i) - d_i| < eps, or, for a no-return reading (d_i = +inf),
+ *        space and |h(q (+) g_i) - d_i| < eps (h: predictedRange(), the cone cast for a cone
+ *        reading), or, for a no-return reading (d_i = +inf),
  *        when h(q (+) g_i) > max_range_i - eps. A reading the map contradicts (see
  *        PoseEvaluation::contradicted) counts against the pose in the ranking.
  * @param eps agreement tolerance [m]
@@ -81,6 +89,10 @@ struct RefinementSettings
                                           ///< around the seed; 0 = no local search
   double local_search_step = 0.05;        ///< lattice step of that search in x, y [m]
   double local_search_angle_step = 0.02;  ///< ... and in theta [rad]
+  int multi_start = 0;                    ///< finally, polish again from the (2m+1)^3 - 1 poses of
+                                          ///< a lattice around the best pose; 0 = none
+  double multi_start_step = 0.05;         ///< lattice step of the multi-start in x, y [m]
+  double multi_start_angle_step = 0.02;   ///< ... and in theta [rad]
 };
 
 /**
@@ -94,11 +106,15 @@ struct RefinementSettings
  *        3. rounds of verification and plain polish on the eps-inliers while the consensus
  *           improves (more inliers, then lower RMS);
  *        4. leave-one-out re-polishes (the worst reading, the ones passing nearest a vertex) to
- *           escape the false minima that corners create in the piecewise-smooth cost.
+ *           escape the false minima that corners create in the piecewise-smooth cost;
+ *        5. optionally (multi_start) annealed polishes from @p region_starts (poses spread over
+ *           the seed's region) and robust polishes from a lattice of poses around the best one,
+ *           on the hypothesis's finite readings, keeping the best (most inliers, then least RMS).
  *        Never returns a pose worse than the seed.
  */
 Candidate refineSeed(const MapRayCaster& map, const Pose2& seed, const std::vector<Reading>& readings,
-                     const std::vector<bool>& hypothesis, const RefinementSettings& settings);
+                     const std::vector<bool>& hypothesis, const RefinementSettings& settings,
+                     const std::vector<Pose2>& region_starts = {});
 
 /**
  * @brief For each reading, how close its ray from @p pose passes to a map vertex, relative to
@@ -109,6 +125,18 @@ Candidate refineSeed(const MapRayCaster& map, const Pose2& seed, const std::vect
  */
 std::vector<double> vertexMargins(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings,
                                   double angle_error);
+
+/**
+ * @brief Widens @p candidate's covariance along each direction (x, y, the heading, the walls its
+ *        inlier rays hit) in which its pose can move, both ways, while every finite inlier's
+ *        residual stays within its value plus @p noise [m]: where that reach R exceeds 3
+ *        standard deviations of the covariance along the direction, the variance along it
+ *        becomes R^2 / 3 (a uniform spread over [-R, R]). The local derivative of the polish
+ *        cannot see a continuum of exact poses (a corridor, parallel walls, a cone facing a flat
+ *        wall) when the pose sits at its end; this says so. Reach probed up to 4 m and pi/2.
+ */
+void widenAlongContinua(const MapRayCaster& map, const std::vector<Reading>& readings, double noise,
+                        Candidate& candidate);
 
 /// A candidate at @p pose, verified but not polished.
 Candidate verifiedCandidate(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings,

@@ -25,8 +25,11 @@ struct SearchSeed
   std::vector<bool> hypothesis;     ///< per reading: the seed's region lies in its preimage
   int promised = 0;                 ///< readings the seed's region explains (its peak count)
   std::vector<Pose2> retry_starts;  ///< other poses of the region, for second chances
-  std::size_t region = 0;           ///< the engine's id of the seed's region (voxel, leaf cluster)
-  double support = 0.0;             ///< size of the seed's region (voxels or boxes)
+  /// Poses spread over the region, for the final multi-start of the candidate the seed gives
+  /// (empty: retry_starts)
+  std::vector<Pose2> region_starts;
+  std::size_t region = 0;  ///< the engine's id of the seed's region (voxel, leaf cluster)
+  double support = 0.0;    ///< size of the seed's region (voxels or boxes)
 };
 
 /// What an engine supplies to the robust search.

@@ -2,6 +2,7 @@
 // shared robust search (seed_search.h), or verified component centres (paper, baseline).
 #include "fdml_localization/core/localization/adaptive/adaptive_engine.h"
 
+#include "fdml_localization/core/localization/certificate.h"
 #include "fdml_localization/core/localization/ranking.h"
 #include "fdml_localization/core/localization/robust_search.h"
 #include "fdml_localization/core/localization/seed_search.h"
@@ -19,6 +20,8 @@ namespace core
 {
 namespace
 {
+/// Leaves of a plateau (spread over it) the final multi-start polishes from.
+constexpr std::size_t kRegionStarts = 12;
 /// Distinct seeds taken from one plateau.
 constexpr std::size_t kSeedsPerPlateau = 3;
 /// ... from plateaus of at least this many leaves (smaller ones give one seed).
@@ -141,6 +144,11 @@ public:
         seed.retry_starts = { found.leaves[cluster.representative].box.centre(),
                               found.leaves[cluster.members[n / 3]].box.centre(),
                               found.leaves[cluster.members[(2 * n) / 3]].box.centre() };
+        const std::size_t spread = std::min(n, kRegionStarts);
+        for (std::size_t j = 0; j < spread; ++j)
+        {
+          seed.region_starts.push_back(found.leaves[cluster.members[j * n / spread]].box.centre());
+        }
         seeds.push_back(std::move(seed));
       }
     }
@@ -189,6 +197,8 @@ Result AdaptiveEngine::localize(const std::vector<Reading>& readings)
   }
   result.boxes_per_level = search.result().boxes_per_level;
   result.truncated = search.result().truncated;
+  const std::int64_t theta_cells = std::max<std::int64_t>(1, std::llround(kTwoPi / cell_theta_));
+  certifyAdaptive(*map_, readings, options_.range_tolerance, search, theta_cells, result);
   last_leaves_ = search.result().leaves;
   result.times.total = secondsSince(start);
   return result;

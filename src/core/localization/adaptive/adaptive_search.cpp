@@ -15,9 +15,8 @@ bool outsideFreeSpace(const MapRayCaster& map, const Box2& box)
   return !map.grid().anySegmentInBox(box) && !map.isFree(0.5 * (box.min + box.max));
 }
 
-Box2 sweep(const Box2& positions, const Vec2& v, double t0, double t1, double inflate)
+Box2 sweep(const Box2& positions, const Box2& arc, double inflate)
 {
-  const Box2 arc = rotatedArcBounds(v, t0, t1);
   Box2 out;
   out.min = positions.min + arc.min - Vec2(inflate, inflate);
   out.max = positions.max + arc.max + Vec2(inflate, inflate);
@@ -49,6 +48,26 @@ Box2 rotatedArcBounds(const Vec2& v, double t0, double t1)
   return box;
 }
 
+Box2 hitArcBounds(const Reading& reading, double t0, double t1)
+{
+  if (!std::isfinite(reading.range))
+  {
+    return Box2();
+  }
+  const Pose2& g = reading.offset;
+  const Vec2 direction(reading.range * std::cos(g.theta), reading.range * std::sin(g.theta));
+  if (reading.half_angle <= 0.0)
+  {
+    return rotatedArcBounds(Vec2(g.x, g.y) + direction, t0, t1);
+  }
+  const Box2 sensor = rotatedArcBounds(Vec2(g.x, g.y), t0, t1);
+  const Box2 ray = rotatedArcBounds(direction, t0 - reading.half_angle, t1 + reading.half_angle);
+  Box2 out;
+  out.min = sensor.min + ray.min;
+  out.max = sensor.max + ray.max;
+  return out;
+}
+
 bool readingMayExplain(const MapRayCaster& map, const Reading& reading, const PoseBox& box, double range_tolerance)
 {
   Box2 positions;
@@ -57,7 +76,8 @@ bool readingMayExplain(const MapRayCaster& map, const Reading& reading, const Po
   const Pose2& g = reading.offset;
   // The sensor must be in free space somewhere in the box (for a sensor at the base origin the
   // caller's robot-position test already says so).
-  if ((g.x != 0.0 || g.y != 0.0) && outsideFreeSpace(map, sweep(positions, Vec2(g.x, g.y), box.t0, box.t1, 0.0)))
+  if ((g.x != 0.0 || g.y != 0.0) &&
+      outsideFreeSpace(map, sweep(positions, rotatedArcBounds(Vec2(g.x, g.y), box.t0, box.t1), 0.0)))
   {
     return false;
   }
@@ -65,8 +85,7 @@ bool readingMayExplain(const MapRayCaster& map, const Reading& reading, const Po
   {
     return true;  // a no-return reading is only checked exactly, in verification
   }
-  const Vec2 v(g.x + reading.range * std::cos(g.theta), g.y + reading.range * std::sin(g.theta));
-  return map.grid().anySegmentInBox(sweep(positions, v, box.t0, box.t1, range_tolerance));
+  return map.grid().anySegmentInBox(sweep(positions, hitArcBounds(reading, box.t0, box.t1), range_tolerance));
 }
 
 AdaptiveSearchResult adaptiveSearch(const MapRayCaster& map, const std::vector<Reading>& readings,

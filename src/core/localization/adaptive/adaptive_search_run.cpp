@@ -98,11 +98,7 @@ void AdaptiveSearch::prepareArcs(int level)
     for (std::size_t r = 0; r < k; ++r)
     {
       const Reading& reading = readings_[r];
-      const Vec2 hit = std::isfinite(reading.range) ?
-                           Vec2(reading.offset.x + reading.range * std::cos(reading.offset.theta),
-                                reading.offset.y + reading.range * std::sin(reading.offset.theta)) :
-                           Vec2::Zero();
-      arcs_[level][(t * k + r) * 2] = rotatedArcBounds(hit, t0, t1);
+      arcs_[level][(t * k + r) * 2] = hitArcBounds(reading, t0, t1);
       arcs_[level][(t * k + r) * 2 + 1] = rotatedArcBounds(Vec2(reading.offset.x, reading.offset.y), t0, t1);
     }
   }
@@ -133,22 +129,11 @@ bool AdaptiveSearch::test(Node& n, int level, int min_count) const
     }
     const Reading& reading = readings_[r];
     const bool offset = reading.offset.x != 0.0 || reading.offset.y != 0.0;
-    Box2 hit_arc, sensor_arc;
-    if (!table.empty())
-    {
-      hit_arc = table[row + 2 * r];
-      sensor_arc = table[row + 2 * r + 1];
-    }
-    else
-    {
-      const Vec2 g(reading.offset.x, reading.offset.y);
-      sensor_arc = offset ? rotatedArcBounds(g, b.t0, b.t1) : Box2();
-      hit_arc =
-          std::isfinite(reading.range) ?
-              rotatedArcBounds(g + reading.range * Vec2(std::cos(reading.offset.theta), std::sin(reading.offset.theta)),
-                               b.t0, b.t1) :
-              Box2();
-    }
+    // The arcs from the level's table, or computed for this box at the finer theta levels.
+    const Box2 hit_arc = table.empty() ? hitArcBounds(reading, b.t0, b.t1) : table[row + 2 * r];
+    const Box2 sensor_arc = !table.empty() ? table[row + 2 * r + 1] :
+                            offset         ? rotatedArcBounds(Vec2(reading.offset.x, reading.offset.y), b.t0, b.t1) :
+                                             Box2();
     // The sensor must be in free space somewhere in the box.
     if (offset && !occupancy_.mayBeFree(sweep(positions, sensor_arc, 0.0)))
     {
@@ -173,14 +158,130 @@ bool AdaptiveSearch::test(Node& n, int level, int min_count) const
   return count >= min_count;
 }
 
+int AdaptiveSearch::consensusBound() const
+{
+  int bound = options_.floor_count - 1;
+  for (const LeafBox& leaf : result_.leaves)
+  {
+    bound = std::max(bound, leaf.count);
+  }
+  for (const std::vector<Node>& level : set_aside_)
+  {
+    for (const Node& n : level)
+    {
+      bound = std::max(bound, static_cast<int>(n.count));
+    }
+  }
+  return std::min(bound, static_cast<int>(readings_.size()));
+}
+
+bool AdaptiveSearch::unresolvedReaches(int count) const
+{
+  return std::any_of(set_aside_.begin(), set_aside_.end(), [&](const std::vector<Node>& level) {
+    return std::any_of(level.begin(), level.end(), [&](const Node& n) { return n.count >= count; });
+  });
+}
+
+bool AdaptiveSearch::resumeSetAside(int level, int min_count, std::vector<Node>& current)
+{
+  // Boxes set aside by earlier runs whose upper bound reaches the new k'.
+  std::vector<Node>& aside = set_aside_[level];
+  auto resumed = std::partition(aside.begin(), aside.end(), [&](const Node& n) { return n.count < min_count; });
+  // Within the box budget only: the rest stays aside and the search ends after this level.
+  const long room = std::max(0L, options_.max_boxes - result_.boxes_tested - static_cast<long>(current.size()));
+  bool cut = false;
+  if (aside.end() - resumed > room)
+  {
+    resumed = aside.end() - room;
+    cut = true;
+  }
+  current.insert(current.end(), resumed, aside.end());
+  aside.erase(resumed, aside.end());
+  return cut;
+}
+
+void AdaptiveSearch::testLevel(int level, int min_count, std::vector<Node>& current, std::vector<Node>& survivors)
+{
+  const int threads = options_.threads > 0 ? options_.threads : omp_get_max_threads();
+  std::vector<Outcome> outcome(current.size(), Outcome::Pruned);
+  const long size = static_cast<long>(current.size());
+#pragma omp parallel for schedule(dynamic, 64) num_threads(threads) if (size > options_.parallel_threshold)
+  for (long i = 0; i < size; ++i)
+  {
+    if (test(current[i], level, min_count))
+    {
+      outcome[i] = Outcome::Kept;
+    }
+    else if (current[i].count >= options_.floor_count)
+    {
+      outcome[i] = Outcome::SetAside;
+    }
+  }
+  result_.boxes_tested += size;
+  survivors.clear();
+  for (long i = 0; i < size; ++i)
+  {
+    if (outcome[i] == Outcome::Kept)
+    {
+      survivors.push_back(current[i]);
+    }
+    else if (outcome[i] == Outcome::SetAside)
+    {
+      set_aside_[level].push_back(current[i]);
+    }
+  }
+  result_.boxes_per_level[level] += static_cast<long>(survivors.size());
+}
+
+void AdaptiveSearch::addLeaves(const std::vector<Node>& survivors, int level)
+{
+  for (const Node& n : survivors)
+  {
+    LeafBox leaf;
+    leaf.box = boxOf(n, level);
+    leaf.count = n.count;
+    leaf.mask = n.mask;
+    leaf.ix = n.ix;
+    leaf.iy = n.iy;
+    leaf.it = n.it;
+    result_.leaves.push_back(leaf);
+  }
+}
+
+void AdaptiveSearch::split(const std::vector<Node>& survivors, int level, std::vector<Node>& children) const
+{
+  auto halves = [&](int axis_levels) { return axis_levels > level ? 2 : 1; };
+  const int sx = halves(lx_), sy = halves(ly_), st = halves(lt_);
+  const std::int32_t cx = static_cast<std::int32_t>(std::int64_t{ 1 } << std::max(lx_ - level - 1, 0));
+  const std::int32_t cy = static_cast<std::int32_t>(std::int64_t{ 1 } << std::max(ly_ - level - 1, 0));
+  const std::int32_t ct = static_cast<std::int32_t>(std::int64_t{ 1 } << std::max(lt_ - level - 1, 0));
+  children.clear();
+  children.reserve(survivors.size() * static_cast<std::size_t>(sx * sy * st));
+  for (const Node& n : survivors)
+  {
+    for (int a = 0; a < sx; ++a)
+    {
+      for (int b = 0; b < sy; ++b)
+      {
+        for (int c = 0; c < st; ++c)
+        {
+          const Node child{ n.ix + a * cx, n.iy + b * cy, n.it + c * ct, 0, 0 };
+          if (child.ix < nx_ && child.iy < ny_ && child.it < nt_)
+          {
+            children.push_back(child);
+          }
+        }
+      }
+    }
+  }
+}
+
 const AdaptiveSearchResult& AdaptiveSearch::run(int min_count)
 {
   if (finished_)
   {
     return result_;
   }
-  const int threads = options_.threads > 0 ? options_.threads : omp_get_max_threads();
-  const long threshold = options_.parallel_threshold;
   std::vector<Node> current;
   if (!started_)
   {
@@ -190,54 +291,12 @@ const AdaptiveSearchResult& AdaptiveSearch::run(int min_count)
   std::vector<Node> survivors;
   for (int level = 0; level <= levels_; ++level)
   {
-    // Boxes set aside by earlier runs whose upper bound reaches the new k'.
-    std::vector<Node>& aside = set_aside_[level];
-    auto resumed = std::partition(aside.begin(), aside.end(), [&](const Node& n) { return n.count < min_count; });
-    // Within the box budget only: the rest stays aside and the search ends after this level.
-    const long room = std::max(0L, options_.max_boxes - result_.boxes_tested - static_cast<long>(current.size()));
-    bool cut = false;
-    if (aside.end() - resumed > room)
-    {
-      resumed = aside.end() - room;
-      cut = true;
-    }
-    current.insert(current.end(), resumed, aside.end());
-    aside.erase(resumed, aside.end());
+    const bool cut = resumeSetAside(level, min_count, current);
     prepareArcs(level);
-
-    std::vector<Outcome> outcome(current.size(), Outcome::Pruned);
-    const long size = static_cast<long>(current.size());
-#pragma omp parallel for schedule(dynamic, 64) num_threads(threads) if (size > threshold)
-    for (long i = 0; i < size; ++i)
-    {
-      if (test(current[i], level, min_count))
-      {
-        outcome[i] = Outcome::Kept;
-      }
-      else if (current[i].count >= options_.floor_count)
-      {
-        outcome[i] = Outcome::SetAside;
-      }
-    }
-    result_.boxes_tested += size;
-    survivors.clear();
-    for (long i = 0; i < size; ++i)
-    {
-      if (outcome[i] == Outcome::Kept)
-      {
-        survivors.push_back(current[i]);
-      }
-      else if (outcome[i] == Outcome::SetAside)
-      {
-        aside.push_back(current[i]);
-      }
-    }
-    result_.boxes_per_level[level] += static_cast<long>(survivors.size());
-
+    testLevel(level, min_count, current, survivors);
     const bool last = level == levels_;
-    auto split = [&](int axis_levels) { return (!last && axis_levels > level) ? 2 : 1; };
-    const int sx = split(lx_), sy = split(ly_), st = split(lt_);
-    const long children = static_cast<long>(survivors.size()) * sx * sy * st;
+    auto halves = [&](int axis_levels) { return (!last && axis_levels > level) ? 2 : 1; };
+    const long children = static_cast<long>(survivors.size()) * halves(lx_) * halves(ly_) * halves(lt_);
     elapsed_ = std::chrono::duration<double>(Clock::now() - start_).count();
     const bool out_of_budget = cut || (!last && (result_.boxes_tested + children > options_.max_boxes ||
                                                  (options_.deadline > 0.0 && elapsed_ > options_.deadline)));
@@ -246,41 +305,10 @@ const AdaptiveSearchResult& AdaptiveSearch::run(int min_count)
       // A cut search reports the boxes of the last full level as its leaves and stops for good.
       result_.truncated = out_of_budget && (cut || !survivors.empty());
       finished_ = out_of_budget;
-      for (const Node& n : survivors)
-      {
-        LeafBox leaf;
-        leaf.box = boxOf(n, level);
-        leaf.count = n.count;
-        leaf.mask = n.mask;
-        leaf.ix = n.ix;
-        leaf.iy = n.iy;
-        leaf.it = n.it;
-        result_.leaves.push_back(leaf);
-      }
+      addLeaves(survivors, level);
       break;
     }
-    const std::int32_t cx = static_cast<std::int32_t>(std::int64_t{ 1 } << std::max(lx_ - level - 1, 0));
-    const std::int32_t cy = static_cast<std::int32_t>(std::int64_t{ 1 } << std::max(ly_ - level - 1, 0));
-    const std::int32_t ct = static_cast<std::int32_t>(std::int64_t{ 1 } << std::max(lt_ - level - 1, 0));
-    current.clear();
-    current.reserve(static_cast<std::size_t>(children));
-    for (const Node& n : survivors)
-    {
-      for (int a = 0; a < sx; ++a)
-      {
-        for (int b = 0; b < sy; ++b)
-        {
-          for (int c = 0; c < st; ++c)
-          {
-            const Node child{ n.ix + a * cx, n.iy + b * cy, n.it + c * ct, 0, 0 };
-            if (child.ix < nx_ && child.iy < ny_ && child.it < nt_)
-            {
-              current.push_back(child);
-            }
-          }
-        }
-      }
-    }
+    split(survivors, level, current);
   }
   return result_;
 }

@@ -107,6 +107,75 @@ LeafCluster plateauCluster(const std::vector<LeafBox>& leaves, const std::vector
   }
   return c;
 }
+/// One cluster per connected plateau of the peak count of @p component (a connected component).
+void addPlateauClusters(const std::vector<LeafBox>& leaves, const std::vector<std::size_t>& component,
+                        std::int64_t theta_cells, std::vector<LeafCluster>& clusters)
+{
+  int peak = 0;
+  for (const std::size_t i : component)
+  {
+    peak = std::max(peak, leaves[i].count);
+  }
+  std::vector<std::size_t> plateau;
+  for (const std::size_t i : component)
+  {
+    if (leaves[i].count == peak)
+    {
+      plateau.push_back(i);
+    }
+  }
+  DisjointSets plateaus(leaves.size());
+  uniteNeighbours(leaves, plateau, theta_cells, plateaus);
+  std::unordered_map<std::size_t, std::vector<std::size_t>> parts;
+  for (const std::size_t i : plateau)
+  {
+    parts[plateaus.find(i)].push_back(i);
+  }
+  for (auto& part : parts)
+  {
+    LeafCluster c = plateauCluster(leaves, part.second);
+    c.size = component.size();
+    c.peak_count = peak;
+    clusters.push_back(c);
+  }
+}
+
+/**
+ * Unites the plateau leaves (count == @p level) with their neighbours of the same count and
+ * marks those touching a leaf of a higher count (@p index: every leaf with count >= level).
+ */
+void unitePlateau(const std::vector<LeafBox>& leaves, const std::vector<std::size_t>& plateau,
+                  const std::unordered_map<std::uint64_t, std::size_t>& index, int level, std::int64_t theta_cells,
+                  DisjointSets& sets, std::vector<char>& dominated)
+{
+  for (const std::size_t i : plateau)
+  {
+    const LeafBox& l = leaves[i];
+    for (int dt = -1; dt <= 1; ++dt)
+    {
+      const std::int64_t t = ((l.it + dt) % theta_cells + theta_cells) % theta_cells;
+      for (int dy = -1; dy <= 1; ++dy)
+      {
+        for (int dx = -1; dx <= 1; ++dx)
+        {
+          const auto found = index.find(cellKey(l.ix + dx, l.iy + dy, t));
+          if (l.ix + dx < 0 || l.iy + dy < 0 || found == index.end())
+          {
+            continue;
+          }
+          if (leaves[found->second].count > level)
+          {
+            dominated[i] = 1;
+          }
+          else
+          {
+            sets.unite(i, found->second);
+          }
+        }
+      }
+    }
+  }
+}
 }  // namespace
 
 std::vector<LeafCluster> clusterLeaves(const std::vector<LeafBox>& leaves, int level, std::int64_t theta_cells)
@@ -129,34 +198,7 @@ std::vector<LeafCluster> clusterLeaves(const std::vector<LeafBox>& leaves, int l
   std::vector<LeafCluster> clusters;
   for (auto& entry : by_root)
   {
-    const std::vector<std::size_t>& component = entry.second;
-    int peak = 0;
-    for (const std::size_t i : component)
-    {
-      peak = std::max(peak, leaves[i].count);
-    }
-    std::vector<std::size_t> plateau;
-    for (const std::size_t i : component)
-    {
-      if (leaves[i].count == peak)
-      {
-        plateau.push_back(i);
-      }
-    }
-    DisjointSets plateaus(leaves.size());
-    uniteNeighbours(leaves, plateau, theta_cells, plateaus);
-    std::unordered_map<std::size_t, std::vector<std::size_t>> parts;
-    for (const std::size_t i : plateau)
-    {
-      parts[plateaus.find(i)].push_back(i);
-    }
-    for (auto& part : parts)
-    {
-      LeafCluster c = plateauCluster(leaves, part.second);
-      c.size = component.size();
-      c.peak_count = peak;
-      clusters.push_back(c);
-    }
+    addPlateauClusters(leaves, entry.second, theta_cells, clusters);
   }
   // Deterministic order: highest peak, then largest component, then position.
   std::sort(clusters.begin(), clusters.end(), [](const LeafCluster& a, const LeafCluster& b) {
@@ -190,33 +232,7 @@ std::vector<LeafCluster> leafMaxima(const std::vector<LeafBox>& leaves, int leve
   }
   DisjointSets sets(leaves.size());
   std::vector<char> dominated(leaves.size(), 0);
-  for (const std::size_t i : plateau)
-  {
-    const LeafBox& l = leaves[i];
-    for (int dt = -1; dt <= 1; ++dt)
-    {
-      const std::int64_t t = ((l.it + dt) % theta_cells + theta_cells) % theta_cells;
-      for (int dy = -1; dy <= 1; ++dy)
-      {
-        for (int dx = -1; dx <= 1; ++dx)
-        {
-          const auto found = index.find(cellKey(l.ix + dx, l.iy + dy, t));
-          if (l.ix + dx < 0 || l.iy + dy < 0 || found == index.end())
-          {
-            continue;
-          }
-          if (leaves[found->second].count > level)
-          {
-            dominated[i] = 1;
-          }
-          else
-          {
-            sets.unite(i, found->second);
-          }
-        }
-      }
-    }
-  }
+  unitePlateau(leaves, plateau, index, level, theta_cells, sets, dominated);
   std::unordered_map<std::size_t, std::vector<std::size_t>> parts;
   for (const std::size_t i : plateau)
   {
@@ -242,6 +258,30 @@ std::vector<LeafCluster> leafMaxima(const std::vector<LeafBox>& leaves, int leve
     return a.size != b.size ? a.size > b.size : a.representative < b.representative;
   });
   return maxima;
+}
+
+std::vector<int> leafComponents(const std::vector<LeafBox>& leaves, int level, std::int64_t theta_cells,
+                                int& components)
+{
+  std::vector<std::size_t> members;
+  for (std::size_t i = 0; i < leaves.size(); ++i)
+  {
+    if (leaves[i].count >= level)
+    {
+      members.push_back(i);
+    }
+  }
+  DisjointSets sets(leaves.size());
+  uniteNeighbours(leaves, members, theta_cells, sets);
+  std::vector<int> labels(leaves.size(), -1);
+  std::unordered_map<std::size_t, int> label_of_root;
+  for (const std::size_t i : members)
+  {
+    const auto found = label_of_root.emplace(sets.find(i), static_cast<int>(label_of_root.size()));
+    labels[i] = found.first->second;
+  }
+  components = static_cast<int>(label_of_root.size());
+  return labels;
 }
 
 }  // namespace core

@@ -6,6 +6,9 @@
  * (x, y) + R(theta) v, v = (gx + d cos g_theta, gy + d sin g_theta), lies in the exact bounding
  * box of the arc R(theta) v over [t0, t1] plus [x0,x1] x [y0,y1], inflated by the range
  * tolerance. When no map edge meets that box, the reading cannot be explained anywhere in B.
+ * A cone reading of half-angle a (the nearest map point within a sector) has its hit point at
+ * distance d in some direction of the sector: the heading interval of the direction's arc is
+ * widened by a on each side (hitArcBounds()), which keeps the test conservative.
  * A box survives while at least k' readings may be explained, so the box holding the truth is
  * never pruned (no exceptions near discontinuities of h), and the work grows with the answer.
  */
@@ -81,6 +84,17 @@ bool readingMayExplain(const MapRayCaster& map, const Reading& reading, const Po
 /// Exact bounding box of the arc R(theta) v for theta in [t0, t1] (t1 - t0 <= 2 pi).
 Box2 rotatedArcBounds(const Vec2& v, double t0, double t1);
 
+/**
+ * @brief A box holding every hit point of @p reading relative to the robot's position, for every
+ *        robot heading in [t0, t1] [rad] (empty for a no-return reading). A ray (half_angle 0):
+ *        the exact bounds of the arc R(theta) v, v = (gx + d cos g_theta, gy + d sin g_theta).
+ *        A cone of half-angle a: the hit point is the sensor position R(theta) (gx, gy) plus d in
+ *        a direction within [theta + g_theta - a, theta + g_theta + a], so the sum of the bounds
+ *        of the sensor's arc over [t0, t1] and of the arc of d (cos g_theta, sin g_theta) over
+ *        [t0 - a, t1 + a].
+ */
+Box2 hitArcBounds(const Reading& reading, double t0, double t1);
+
 /// Runs the search over the map's bounding box x [-pi, pi).
 AdaptiveSearchResult adaptiveSearch(const MapRayCaster& map, const std::vector<Reading>& readings,
                                     const AdaptiveSearchOptions& options);
@@ -110,6 +124,16 @@ public:
     return result_;
   }
 
+  /**
+   * @brief An upper bound on the readings any pose of the searched space explains within the
+   *        range tolerance: the largest count of the leaves and of the boxes set aside (their
+   *        counts are upper bounds), and floor_count - 1 for the boxes pruned.
+   */
+  int consensusBound() const;
+
+  /// True when a box set aside unresolved (by a budget, or below every k' run) may reach @p count.
+  bool unresolvedReaches(int count) const;
+
 private:
   struct Node
   {
@@ -121,6 +145,14 @@ private:
   /// Tests one node against @p min_count; fills count (exact when kept) and mask.
   bool test(Node& n, int level, int min_count) const;
   void prepareArcs(int level);
+  /// Moves the set-aside boxes of @p level that may reach @p min_count into @p current, within
+  /// the box budget; true when the budget cut them.
+  bool resumeSetAside(int level, int min_count, std::vector<Node>& current);
+  /// Tests @p current: the kept boxes go to @p survivors, those that may reach floor_count aside.
+  void testLevel(int level, int min_count, std::vector<Node>& current, std::vector<Node>& survivors);
+  void addLeaves(const std::vector<Node>& survivors, int level);
+  /// The children of @p survivors at the next level (halving the axes not yet at leaf size).
+  void split(const std::vector<Node>& survivors, int level, std::vector<Node>& children) const;
 
   const MapRayCaster& map_;
   const BoxOccupancy& occupancy_;

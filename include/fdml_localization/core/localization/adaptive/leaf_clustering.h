@@ -17,9 +17,9 @@ namespace core
 /// A cluster of surviving leaves: its peak-count plateau gives one seed.
 struct LeafCluster
 {
-  Pose2 centroid;           ///< mean x, y [m], circular mean theta [rad] of the plateau leaves
+  Pose2 centroid;                  ///< mean x, y [m], circular mean theta [rad] of the plateau leaves
   std::size_t representative = 0;  ///< index (into the leaves) of the plateau leaf nearest the centroid
-  std::size_t size = 0;     ///< leaves in the whole connected component
+  std::size_t size = 0;            ///< leaves in the whole connected component
   int peak_count = 0;
   std::vector<std::size_t> members;  ///< plateau leaves (leafMaxima only), ascending
 };
@@ -36,6 +36,14 @@ std::vector<LeafCluster> clusterLeaves(const std::vector<LeafBox>& leaves, int l
  *        of the leaves with count == level that touch no leaf with a higher count; largest first.
  */
 std::vector<LeafCluster> leafMaxima(const std::vector<LeafBox>& leaves, int level, std::int64_t theta_cells);
+
+/**
+ * @brief The connected components (26 neighbours, periodic theta) of the leaves with count >=
+ *        @p level: one label per leaf, -1 for the leaves below @p level.
+ * @param components receives the number of components (labels 0 .. components - 1)
+ */
+std::vector<int> leafComponents(const std::vector<LeafBox>& leaves, int level, std::int64_t theta_cells,
+                                int& components);
 
 }  // namespace core
 }  // namespace fdml_localization

@@ -1,0 +1,200 @@
+// The certificate of an answer: the proved consensus bound and the regions reaching it.
+#include "fdml_localization/core/localization/certificate.h"
+
+#include "fdml_localization/core/localization/adaptive/leaf_clustering.h"
+#include "fdml_localization/core/localization/components.h"
+#include "fdml_localization/core/localization/robust_search.h"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+namespace fdml_localization
+{
+namespace core
+{
+namespace
+{
+/// Halvings of every axis a region's boxes get before the region counts as not excluded.
+constexpr int kExclusionDepth = 3;
+/// Box tests the exclusion of all regions may spend.
+constexpr long kExclusionBudget = 20000;
+
+/// The readings @p box may explain (box test of adaptive_search.h), counted until it is clear
+/// whether @p needed is reached.
+int boxCount(const MapRayCaster& map, const std::vector<Reading>& readings, double tolerance, const PoseBox& box,
+             int needed)
+{
+  const Box2 positions{ Vec2(box.x0, box.y0), Vec2(box.x1, box.y1) };
+  if (!map.grid().anySegmentInBox(positions) && !map.isFree(0.5 * (positions.min + positions.max)))
+  {
+    return 0;  // the robot's base is outside free space everywhere in the box
+  }
+  int count = 0;
+  const int k = static_cast<int>(readings.size());
+  for (int i = 0; i < k && count + (k - i) >= needed; ++i)
+  {
+    count += readingMayExplain(map, readings[static_cast<std::size_t>(i)], box, tolerance) ? 1 : 0;
+  }
+  return count;
+}
+
+/// True when some sub-box of @p box, halved @p depth times along every axis, may still explain
+/// @p needed readings (or the budget ran out).
+bool mayReach(const MapRayCaster& map, const std::vector<Reading>& readings, double tolerance, const PoseBox& box,
+              int needed, int depth, long& budget)
+{
+  if (--budget < 0)
+  {
+    return true;
+  }
+  if (boxCount(map, readings, tolerance, box, needed) < needed)
+  {
+    return false;
+  }
+  if (depth == 0)
+  {
+    return true;
+  }
+  const double xm = 0.5 * (box.x0 + box.x1), ym = 0.5 * (box.y0 + box.y1), tm = 0.5 * (box.t0 + box.t1);
+  for (int c = 0; c < 8; ++c)
+  {
+    PoseBox child = box;
+    ((c & 1) ? child.x0 : child.x1) = xm;
+    ((c & 2) ? child.y0 : child.y1) = ym;
+    ((c & 4) ? child.t0 : child.t1) = tm;
+    if (mayReach(map, readings, tolerance, child, needed, depth - 1, budget))
+    {
+      return true;
+    }
+  }
+  return false;
+}
+
+/// The boxes reaching the bound, with the region each belongs to.
+struct BoundRegions
+{
+  int count = 0;
+  std::vector<PoseBox> boxes;
+  std::vector<int> region;  ///< per box
+};
+
+bool contains(const PoseBox& b, const Pose2& q)
+{
+  const double t = b.t0 + std::remainder(q.theta - b.t0, kTwoPi);
+  return q.x >= b.x0 && q.x <= b.x1 && q.y >= b.y0 && q.y <= b.y1 &&
+         ((t >= b.t0 && t <= b.t1) || (t + kTwoPi >= b.t0 && t + kTwoPi <= b.t1));
+}
+
+/// Fills @p result.certificate: covered regions hold a candidate's pose; the others are
+/// excluded when no sub-box of theirs may reach the bound.
+void certify(const MapRayCaster& map, const std::vector<Reading>& readings, double tolerance, int bound,
+             const BoundRegions& regions, bool unresolved, Result& result)
+{
+  Certificate& c = result.certificate;
+  c.max_consensus_bound = bound;
+  c.best_consensus =
+      result.candidates.empty() ? 0 : consensusWithin(map, result.candidates.front().pose, readings, tolerance);
+  c.regions_at_bound = regions.count;
+  std::vector<char> covered(static_cast<std::size_t>(regions.count), 0);
+  for (std::size_t b = 0; b < regions.boxes.size(); ++b)
+  {
+    for (const Candidate& candidate : result.candidates)
+    {
+      covered[static_cast<std::size_t>(regions.region[b])] |= contains(regions.boxes[b], candidate.pose) ? 1 : 0;
+    }
+  }
+  c.regions_covered = static_cast<int>(std::count(covered.begin(), covered.end(), 1));
+  if (bound < 0 || c.best_consensus != bound || unresolved)
+  {
+    return;  // the certificate is incomplete whatever the other regions hold
+  }
+  std::vector<char> reachable(covered.size(), 0);
+  long budget = kExclusionBudget;
+  for (std::size_t b = 0; b < regions.boxes.size(); ++b)
+  {
+    const std::size_t r = static_cast<std::size_t>(regions.region[b]);
+    if (!covered[r] && !reachable[r])
+    {
+      reachable[r] = mayReach(map, readings, tolerance, regions.boxes[b], bound, kExclusionDepth, budget) ? 1 : 0;
+    }
+  }
+  c.regions_excluded =
+      regions.count - c.regions_covered - static_cast<int>(std::count(reachable.begin(), reachable.end(), 1));
+  c.complete = c.regions_covered + c.regions_excluded == regions.count;
+}
+}  // namespace
+
+int consensusWithin(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings, double tolerance)
+{
+  int count = 0;
+  for (const Reading& reading : readings)
+  {
+    const Pose2 sensor = compose(pose, reading.offset);
+    if (!map.isFree(sensor.position()))
+    {
+      continue;
+    }
+    if (std::isfinite(reading.range))
+    {
+      count += std::abs(predictedRange(map, sensor, reading, kInf) - reading.range) <= tolerance ? 1 : 0;
+    }
+    else
+    {
+      count += predictedRange(map, sensor, reading, reading.max_range + 1.0) >= reading.max_range - tolerance ? 1 : 0;
+    }
+  }
+  return count;
+}
+
+void certifyAdaptive(const MapRayCaster& map, const std::vector<Reading>& readings, double tolerance,
+                     const AdaptiveSearch& search, std::int64_t theta_cells, Result& result)
+{
+  const int bound = search.consensusBound();
+  const std::vector<LeafBox>& leaves = search.result().leaves;
+  BoundRegions regions;
+  const std::vector<int> labels = leafComponents(leaves, bound, theta_cells, regions.count);
+  for (std::size_t i = 0; i < leaves.size(); ++i)
+  {
+    if (labels[i] >= 0)
+    {
+      regions.boxes.push_back(leaves[i].box);
+      regions.region.push_back(labels[i]);
+    }
+  }
+  certify(map, readings, tolerance, bound, regions, search.unresolvedReaches(bound), result);
+}
+
+void certifyVoxels(const MapRayCaster& map, const std::vector<Reading>& readings, double tolerance,
+                   const GridSpec& spec, const std::vector<std::uint8_t>& count, Result& result)
+{
+  const int bound = count.empty() ? -1 : *std::max_element(count.begin(), count.end());
+  BoundRegions regions;
+  if (bound > 0)
+  {
+    const std::vector<VoxelCluster> clusters = connectedComponents(spec, count, bound);
+    regions.count = static_cast<int>(clusters.size());
+    const double dt = spec.thetaStep();
+    for (std::size_t c = 0; c < clusters.size(); ++c)
+    {
+      for (const std::size_t v : clusters[c].voxels)
+      {
+        int ix = 0, iy = 0, it = 0;
+        spec.unindex(v, ix, iy, it);
+        PoseBox box;
+        box.x0 = spec.origin_x + ix * spec.cell;
+        box.x1 = box.x0 + spec.cell;
+        box.y0 = spec.origin_y + iy * spec.cell;
+        box.y1 = box.y0 + spec.cell;
+        box.t0 = -kPi + it * dt;
+        box.t1 = box.t0 + dt;
+        regions.boxes.push_back(box);
+        regions.region.push_back(static_cast<int>(c));
+      }
+    }
+  }
+  certify(map, readings, tolerance, bound, regions, false, result);
+}
+
+}  // namespace core
+}  // namespace fdml_localization

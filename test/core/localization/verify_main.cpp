@@ -1,0 +1,152 @@
+// `make verify` (issue 16): the whole verification suite, as many random trials as fit in the
+// given time (default 10,000 or 15 minutes), both engines; prints the figures per engine and
+// per geometry and every failure; exits 1 when the truth was missed in a noise-free trial or a
+// certificate was contradicted.
+//   verify_localization [--trials N] [--minutes M] [--seed S] [--resolution N]
+#include "verification_trials.h"
+
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <iostream>
+
+namespace
+{
+using fdml_localization::core::Engine;
+using fdml_localization::core::Localizer;
+using fdml_localization::core::LocalizerOptions;
+namespace verification = fdml_localization::core::verification;
+
+struct Args
+{
+  long trials = 10000;
+  double minutes = 15.0;
+  unsigned long seed = 16;
+  int resolution = 64;
+};
+
+bool parse(int argc, char** argv, Args& args)
+{
+  for (int i = 1; i + 1 < argc; i += 2)
+  {
+    char* end = nullptr;
+    const double value = std::strtod(argv[i + 1], &end);
+    if (end == argv[i + 1] || *end != '\0' || !(value > 0.0) || value > 1e9)
+    {
+      std::cerr << "verify_localization: " << argv[i] << " needs a positive number, got '" << argv[i + 1] << "'\n";
+      return false;
+    }
+    if (std::strcmp(argv[i], "--trials") == 0)
+    {
+      args.trials = static_cast<long>(value);
+    }
+    else if (std::strcmp(argv[i], "--minutes") == 0)
+    {
+      args.minutes = value;
+    }
+    else if (std::strcmp(argv[i], "--seed") == 0)
+    {
+      args.seed = static_cast<unsigned long>(value);
+    }
+    else if (std::strcmp(argv[i], "--resolution") == 0 && value >= 16 && value <= 1024)
+    {
+      args.resolution = static_cast<int>(value);
+    }
+    else
+    {
+      std::cerr << "verify_localization: unknown flag or value " << argv[i] << "\n";
+      return false;
+    }
+  }
+  return argc % 2 == 1;
+}
+
+void print(const char* name, const verification::Figures& f)
+{
+  std::printf("%-9s trials %6d  noise-free %6d  undetermined %5d  missed %d  inaccurate %d  contradicted %d  "
+              "far optima %d  complete %5.1f %%  top-1 %5.1f %%  mean %.1f ms\n",
+              name, f.trials, f.noise_free, f.undetermined, f.missed, f.inaccurate, f.contradicted, f.far_optima,
+              f.trials ? 100.0 * f.complete / f.trials : 0.0, f.trials ? 100.0 * f.top1 / f.trials : 0.0,
+              f.trials ? 1000.0 * f.seconds / f.trials : 0.0);
+}
+LocalizerOptions options(Engine engine, int resolution)
+{
+  LocalizerOptions o;
+  o.engine = engine;
+  o.resolution = resolution;
+  o.threads = 1;
+  return o;
+}
+
+void add(const verification::Figures& one, verification::Figures& f)
+{
+  f.trials += one.trials;
+  f.noise_free += one.noise_free;
+  f.undetermined += one.undetermined;
+  f.missed += one.missed;
+  f.inaccurate += one.inaccurate;
+  f.contradicted += one.contradicted;
+  f.far_optima += one.far_optima;
+  f.complete += one.complete;
+  f.top1 += one.top1;
+  f.seconds += one.seconds;
+}
+}  // namespace
+
+int main(int argc, char** argv)
+{
+  Args args;
+  if (!parse(argc, argv, args))
+  {
+    std::cerr << "usage: verify_localization [--trials N] [--minutes M] [--seed S] [--resolution N]\n";
+    return 2;
+  }
+  const auto maps = verification::smallMaps();
+  std::vector<std::unique_ptr<Localizer>> localizers[2];
+  for (int e = 0; e < 2; ++e)
+  {
+    for (const auto& map : maps)
+    {
+      localizers[e].push_back(
+          std::make_unique<Localizer>(map, options(e == 0 ? Engine::Voxel : Engine::Adaptive, args.resolution)));
+    }
+  }
+  std::mt19937_64 rng(args.seed);
+  verification::Figures total[2];
+  verification::Figures by_geometry[2][verification::kGeometries];
+  const auto start = std::chrono::steady_clock::now();
+  long trial_count = 0;
+  for (; trial_count < args.trials; ++trial_count)
+  {
+    if (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > 60.0 * args.minutes)
+    {
+      break;
+    }
+    const verification::Trial trial = verification::makeTrial(maps, rng);
+    for (int e = 0; e < 2; ++e)
+    {
+      verification::Figures one;
+      verification::runTrial(*localizers[e][static_cast<std::size_t>(trial.map)], trial, 300, rng, one);
+      add(one, total[e]);
+      add(one, by_geometry[e][trial.geometry]);
+      for (const std::string& failure : one.failures)
+      {
+        std::printf("FAIL %s: %s\n", e == 0 ? "voxel" : "adaptive", failure.c_str());
+      }
+    }
+  }
+  std::printf("\n%ld trials per engine in %.0f s (seed %lu, resolution %d, maps l_room.poly, L-room 8 x 6 m, "
+              "square_room.poly)\n",
+              trial_count, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), args.seed,
+              args.resolution);
+  for (int e = 0; e < 2; ++e)
+  {
+    print(e == 0 ? "voxel" : "adaptive", total[e]);
+    for (int g = 0; g < verification::kGeometries; ++g)
+    {
+      print(verification::geometryName(g), by_geometry[e][g]);
+    }
+  }
+  const bool ok = total[0].missed + total[1].missed + total[0].contradicted + total[1].contradicted == 0;
+  return ok ? 0 : 1;
+}

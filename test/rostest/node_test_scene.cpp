@@ -143,7 +143,7 @@ void ScenePublisher::publishRange(double range, const std::string& frame, const 
   msg.header.stamp = stamp;
   msg.header.frame_id = frame;
   msg.radiation_type = sensor_msgs::Range::INFRARED;
-  msg.field_of_view = 0.01f;
+  msg.field_of_view = 0.0f;  // the scene computes its ranges as rays
   msg.min_range = 0.02f;
   msg.max_range = static_cast<float>(scene_.max_range);
   msg.range = static_cast<float>(range);

@@ -245,6 +245,9 @@ fdml_localization::LocalizationResult toResultMsg(const core::Result& result)
     msg.stage_times.push_back(stage.second);
   }
   msg.search_truncated = result.truncated;
+  msg.certificate_max_consensus = result.certificate.max_consensus_bound;
+  msg.certificate_best_consensus = result.certificate.best_consensus;
+  msg.certificate_complete = result.certificate.complete;
   msg.unambiguous = core::isUnambiguous(result);
   return msg;
 }

@@ -2,7 +2,6 @@
 
 #include "fdml_localization/ReadingTruth.h"
 #include "fdml_localization/core/map/grid/grid_raster.h"
-#include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/io/map_files.h"
 #include "fdml_localization/ros/conversions.h"
 #include "fdml_localization/ros/markers.h"

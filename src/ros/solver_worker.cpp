@@ -1,5 +1,7 @@
 #include "fdml_localization/ros/solver_worker.h"
 
+#include "fdml_localization/core/localization/voxel/table_cache.h"
+
 #include "fdml_localization/core/localization/ranking.h"
 #include "fdml_localization/core/util/stopwatch.h"
 #include "fdml_localization/ros/conversions.h"
@@ -48,6 +50,16 @@ std::string SolverWorker::noMapMessage() const
          " (~use_map_topic is true and no ~map_file was given)";
 }
 
+void SolverWorker::warnCacheOnce(core::Localizer& localizer)
+{
+  const std::string warning = core::tableCacheWarning(localizer);
+  if (!warning.empty() && !cache_warned_)
+  {
+    ROS_WARN("fdml_localizer: distance-table cache: %s (the tables are built without it)", warning.c_str());
+    cache_warned_ = true;
+  }
+}
+
 void SolverWorker::loop()
 {
   if (localizer_)
@@ -58,6 +70,7 @@ void SolverWorker::loop()
       localizer_->prepare();
       ROS_INFO("fdml_localizer: localizer ready (%s engine, tables in %.2f s)", params_.engine.c_str(),
                core::secondsSince(start));
+      warnCacheOnce(*localizer_);
     }
     catch (const std::exception& error)
     {
@@ -218,6 +231,7 @@ void SolverWorker::applyMap(const nav_msgs::OccupancyGrid::ConstPtr& msg)
     const core::LocalizerOptions options = optionsFor(loaded);
     localizer.reset(new core::Localizer(loaded.map, options));
     localizer->prepare();
+    warnCacheOnce(*localizer);
     tracker = trackerFor(loaded.map, options);
     map = loaded.map;
   }

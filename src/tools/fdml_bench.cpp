@@ -138,45 +138,29 @@ struct Cli
   std::string markdown;
 };
 
+/// @p parse applied to the value of @p flag; its std::invalid_argument becomes a usage error
+/// listing the @p allowed names.
+template <typename Parse>
+auto parseNamed(const std::string& value, const std::string& flag, const char* allowed, Parse parse)
+{
+  try
+  {
+    return parse(value);
+  }
+  catch (const std::invalid_argument&)
+  {
+    throw UsageError(flag + ": '" + value + "' is not one of " + allowed);
+  }
+}
+
 std::vector<core::Method> parseMethods(const std::string& text)
 {
   std::vector<core::Method> methods;
   for (const std::string& m : splitList(text))
   {
-    try
-    {
-      methods.push_back(core::parseMethod(m));
-    }
-    catch (const std::invalid_argument&)
-    {
-      throw UsageError("--method: '" + m + "' is not one of robust, paper, baseline");
-    }
+    methods.push_back(parseNamed(m, "--method", "robust, paper, baseline", core::parseMethod));
   }
   return methods;
-}
-
-core::Engine parseEngineFlag(const std::string& e)
-{
-  try
-  {
-    return core::parseEngine(e);
-  }
-  catch (const std::invalid_argument&)
-  {
-    throw UsageError("--engine: '" + e + "' is not one of voxel, adaptive");
-  }
-}
-
-core::NoReturnPolicy parseNoReturnFlag(const std::string& v)
-{
-  try
-  {
-    return core::parseNoReturn(v);
-  }
-  catch (const std::invalid_argument&)
-  {
-    throw UsageError("--no-return: '" + v + "' is not one of constraint, weak, drop");
-  }
 }
 
 std::uint64_t parseSeed(const std::string& text)
@@ -222,11 +206,15 @@ std::map<std::string, std::function<void(const std::string&)>> valueFlags(Cli& c
         const std::vector<core::Method> methods = parseMethods(v);
         c.methods.insert(c.methods.end(), methods.begin(), methods.end());
       } },
-    { "--engine", [&c](const std::string& v) { c.engine = parseEngineFlag(v); } },
+    { "--engine",
+      [&c](const std::string& v) { c.engine = parseNamed(v, "--engine", "voxel, adaptive", core::parseEngine); } },
     { "--threads", [&c](const std::string& v) { c.threads = core::parseInteger(v, "--threads"); } },
     { "--noise", [&p](const std::string& v) { p.noise = core::parseNumber(v, "--noise"); } },
     { "--fov", [&p](const std::string& v) { p.half_angle = parseFov(v); } },
-    { "--no-return", [&c](const std::string& v) { c.no_return = parseNoReturnFlag(v); } },
+    { "--no-return",
+      [&c](const std::string& v) {
+        c.no_return = parseNamed(v, "--no-return", "constraint, weak, drop", core::parseNoReturn);
+      } },
     { "--csv", [&cli](const std::string& v) { cli.csv = v; } },
     { "--markdown", [&cli](const std::string& v) { cli.markdown = v; } },
   };

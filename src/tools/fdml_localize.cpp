@@ -51,10 +51,36 @@ struct Arguments
   core::ExplicitTolerances set;  ///< tolerances given on the command line (kept on a grid map)
 };
 
+/// Applies one flag that names a method, engine or no-return policy; false for other flags.
+bool applyNameFlag(const std::string& flag, const std::function<std::string()>& value, core::LocalizerOptions& o)
+{
+  if (flag == "--method")
+  {
+    o.method = core::parseMethod(value());
+  }
+  else if (flag == "--engine")
+  {
+    o.engine = core::parseEngine(value());
+  }
+  else if (flag == "--no-return")
+  {
+    o.no_return = core::parseNoReturn(value());
+  }
+  else
+  {
+    return false;
+  }
+  return true;
+}
+
 /// Applies one option flag that takes a value; false when @p flag is not one of them.
 bool applyValueFlag(const std::string& flag, const std::function<std::string()>& value, Arguments& args)
 {
   core::LocalizerOptions& o = args.options;
+  if (applyNameFlag(flag, value, o))
+  {
+    return true;
+  }
   if (flag == "--map")
   {
     args.map = value();
@@ -76,18 +102,6 @@ bool applyValueFlag(const std::string& flag, const std::function<std::string()>&
     {
       throw UsageError("--min-inliers " + v + ": must be 'auto' or an integer >= 3");
     }
-  }
-  else if (flag == "--method")
-  {
-    o.method = core::parseMethod(value());
-  }
-  else if (flag == "--engine")
-  {
-    o.engine = core::parseEngine(value());
-  }
-  else if (flag == "--no-return")
-  {
-    o.no_return = core::parseNoReturn(value());
   }
   else if (flag == "--range-tolerance")
   {

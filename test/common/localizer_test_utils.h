@@ -7,7 +7,10 @@
 #include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/core/localization/voxel/voxel_grid.h"
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
 #include <memory>
 #include <random>
 #include <string>
@@ -19,6 +22,29 @@ namespace core
 {
 namespace test
 {
+/// A small grid spec (0.1 m cells) for unit tests of voxel sets.
+inline GridSpec smallSpec(int nx, int ny, int nt)
+{
+  GridSpec spec;
+  spec.origin_x = -1.0;
+  spec.origin_y = -2.0;
+  spec.cell = 0.1;
+  spec.nx = nx;
+  spec.ny = ny;
+  spec.nt = nt;
+  return spec;
+}
+
+/// A fresh temporary folder for this test process.
+inline std::string tempDir(const std::string& name)
+{
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("fdml_localizer_test_" + name + "_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
 /// An L-shaped 8 x 6 m room with a square pillar and a triangular obstacle.
 inline std::shared_ptr<const MapRayCaster> lRoomMap()
 {

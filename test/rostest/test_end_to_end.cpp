@@ -137,6 +137,43 @@ bool waitFor(Pred pred, double timeout)
   }
   return pred();
 }
+/// Checks that the map -> odom published after the answer numbered @p answered, composed with
+/// odom -> base_link at @p stamp, is the true pose @p t.
+void expectTfMatchesTruth(MapToOdomRecorder& map_odom, std::uint64_t answered, tf2_ros::Buffer& tf_buffer,
+                          const ros::Time& stamp, const TruthSample& t, double pos_tol, double ang_tol)
+{
+  // The map -> odom the localizer publishes after this answer (future-dated, as AMCL does, so a
+  // tf lookup between the old and the new one would interpolate between them) composed with
+  // the simulator's odom -> base_link at the result's stamp is the true pose at that stamp.
+  geometry_msgs::TransformStamped map_to_odom;
+  ASSERT_TRUE(waitFor([&] { return map_odom.latestAfter(answered, map_to_odom); }, 10.0)) << "no map -> odom on tf "
+                                                                                             "after the answer";
+  std::string error;
+  ASSERT_TRUE(tf_buffer.canTransform("odom", "base_link", stamp, ros::Duration(5.0), &error)) << error;
+  const geometry_msgs::TransformStamped odom_to_base = tf_buffer.lookupTransform("odom", "base_link", stamp);
+  tf2::Transform a, b;
+  tf2::fromMsg(map_to_odom.transform, a);
+  tf2::fromMsg(odom_to_base.transform, b);
+  const tf2::Transform map_to_base = a * b;
+  EXPECT_LE(std::hypot(map_to_base.getOrigin().x() - t.x, map_to_base.getOrigin().y() - t.y), pos_tol);
+  EXPECT_LE(angleError(tf2::getYaw(map_to_base.getRotation()), t.yaw), ang_tol);
+}
+
+/// True when some candidate lies within the tolerances of the truth @p t.
+bool truthAmong(const std::vector<fdml_localization::Candidate>& candidates, const TruthSample& t, double pos_tol,
+                double ang_tol)
+{
+  for (const auto& candidate : candidates)
+  {
+    if (std::hypot(candidate.pose.position.x - t.x, candidate.pose.position.y - t.y) <= pos_tol &&
+        angleError(tf2::getYaw(candidate.pose.orientation), t.yaw) <= ang_tol)
+    {
+      return true;
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 TEST(EndToEnd, KidnapsAreRelocalizedAndTfFollows)
@@ -181,13 +218,7 @@ TEST(EndToEnd, KidnapsAreRelocalizedAndTfFollows)
     const bool ok = err_pos <= pos_tol && err_ang <= ang_tol;
     // A symmetric place may leave the answer ambiguous: then the truth must be among the
     // candidates (and no pose is claimed); an unambiguous answer must be right.
-    bool truth_among = false;
-    for (const auto& candidate : result.candidates)
-    {
-      truth_among =
-          truth_among || (std::hypot(candidate.pose.position.x - t.x, candidate.pose.position.y - t.y) <= pos_tol &&
-                          angleError(tf2::getYaw(candidate.pose.orientation), t.yaw) <= ang_tol);
-    }
+    const bool truth_among = truthAmong(result.candidates, t, pos_tol, ang_tol);
     const bool unambiguous = result.unambiguous;
     EXPECT_TRUE(ok || !unambiguous) << "kidnap " << n << ": an unambiguous answer is wrong";
     good += (unambiguous ? ok : truth_among) ? 1 : 0;
@@ -196,23 +227,7 @@ TEST(EndToEnd, KidnapsAreRelocalizedAndTfFollows)
              srv.response.message.c_str());
     if (ok && unambiguous)
     {
-      // The map -> odom the localizer publishes after this answer (future-dated, as AMCL does, so a
-      // tf lookup between the old and the new one would interpolate between them) composed with
-      // the simulator's odom -> base_link at the result's stamp is the true pose at that stamp.
-      geometry_msgs::TransformStamped map_to_odom;
-      ASSERT_TRUE(waitFor([&] { return map_odom.latestAfter(answered, map_to_odom); }, 10.0)) << "no map -> odom on tf "
-                                                                                                 "after the answer";
-      std::string error;
-      ASSERT_TRUE(tf_buffer.canTransform("odom", "base_link", result.header.stamp, ros::Duration(5.0), &error))
-          << error;
-      const geometry_msgs::TransformStamped odom_to_base =
-          tf_buffer.lookupTransform("odom", "base_link", result.header.stamp);
-      tf2::Transform a, b;
-      tf2::fromMsg(map_to_odom.transform, a);
-      tf2::fromMsg(odom_to_base.transform, b);
-      const tf2::Transform map_to_base = a * b;
-      EXPECT_LE(std::hypot(map_to_base.getOrigin().x() - t.x, map_to_base.getOrigin().y() - t.y), pos_tol);
-      EXPECT_LE(angleError(tf2::getYaw(map_to_base.getRotation()), t.yaw), ang_tol);
+      expectTfMatchesTruth(map_odom, answered, tf_buffer, result.header.stamp, t, pos_tol, ang_tol);
       ++tf_checked;
     }
   }

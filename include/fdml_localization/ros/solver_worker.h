@@ -46,6 +46,8 @@ public:
 
 private:
   void loop();
+  /// Warns (once per node) when the distance-table cache could not be used (core::tableCacheWarning).
+  void warnCacheOnce(core::Localizer& localizer);
   /// Takes the next map or job from the shared state; false on shutdown.
   bool takeWork(Job* job, nav_msgs::OccupancyGrid::ConstPtr* map);
   /// A ~localize request: one global solve of its readings.
@@ -108,6 +110,7 @@ private:
   bool published_empty_ = false;                      ///< the last ~result published had no hypothesis
   bool was_tracking_ = false;                         ///< the last batch had a clearly supported hypothesis
   std::thread thread_;
+  bool cache_warned_ = false;  ///< worker thread only
 };
 
 }  // namespace fdml_localization

@@ -1,10 +1,9 @@
-// Unit tests of the voxel localizer's parts, each against an independent brute force:
-// grid, dilation, distance table blocks, preimages, counting vs subset enumeration,
-// components, the table cache, input validation and candidate ranking.
+// Unit tests of the localizer's shared parts, each against an independent brute force:
+// components, maximal hypotheses, input validation and candidate ranking. The voxel engine's
+// parts are in voxel/test_voxel_units.cpp.
 #include "fdml_localization/core/localization/robust_search.h"
 #include "fdml_localization/core/localization/components.h"
 #include "fdml_localization/core/localization/hypothesis_seeds.h"
-#include "fdml_localization/core/localization/voxel/table_cache.h"
 #include "fdml_localization/core/localization/voxel/voxel_engine.h"
 
 #include "localizer_test_utils.h"
@@ -17,6 +16,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <random>
 #include <set>
 
@@ -26,190 +26,7 @@ namespace core
 {
 namespace
 {
-GridSpec smallSpec(int nx, int ny, int nt)
-{
-  GridSpec spec;
-  spec.origin_x = -1.0;
-  spec.origin_y = -2.0;
-  spec.cell = 0.1;
-  spec.nx = nx;
-  spec.ny = ny;
-  spec.nt = nt;
-  return spec;
-}
-
-std::string tempDir(const std::string& name)
-{
-  const auto dir =
-      std::filesystem::temp_directory_path() / ("fdml_localizer_test_" + name + "_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir.string();
-}
-
-TEST(VoxelGrid, FromMapUsesSquareCellsAndAMargin)
-{
-  const auto map = test::lRoomMap();
-  const GridSpec spec = GridSpec::fromMap(map->map(), 64, 0);
-  EXPECT_DOUBLE_EQ(spec.cell, 8.0 / 64);
-  EXPECT_EQ(spec.nx, 66);
-  EXPECT_EQ(spec.ny, 50);
-  EXPECT_EQ(spec.nt, 64);
-  EXPECT_LT(spec.origin_x, 0.0);
-  EXPECT_GT(spec.origin_x + spec.nx * spec.cell, 8.0);
-  EXPECT_THROW(GridSpec::fromMap(map->map(), 15, 0), std::invalid_argument);
-  EXPECT_THROW(GridSpec::fromMap(map->map(), 1025, 0), std::invalid_argument);
-  EXPECT_THROW(GridSpec::fromMap(PolygonMap(), 64, 0), std::invalid_argument);
-  for (std::size_t v : { std::size_t(0), std::size_t(12345), spec.voxelCount() - 1 })
-  {
-    int ix = 0;
-    int iy = 0;
-    int it = 0;
-    ASSERT_TRUE(spec.locate(spec.centre(v), ix, iy, it));
-    EXPECT_EQ(spec.index(ix, iy, it), v);
-  }
-}
-
-TEST(VoxelGrid, DilationMatchesBruteForce)
-{
-  const GridSpec spec = smallSpec(70, 5, 6);  // rows cross a word boundary
-  std::mt19937_64 rng(3);
-  VoxelSet set(spec);
-  for (int i = 0; i < 25; ++i)
-  {
-    set.set(static_cast<int>(rng() % 70), static_cast<int>(rng() % 5), static_cast<int>(rng() % 6));
-  }
-  set.set(63, 0, 0);
-  set.set(69, 4, 5);
-  const VoxelSet dilated = set.dilated();
-  for (int it = 0; it < spec.nt; ++it)
-  {
-    for (int iy = 0; iy < spec.ny; ++iy)
-    {
-      for (int ix = 0; ix < spec.nx; ++ix)
-      {
-        bool expected = set.test(ix, iy, it);
-        forEachNeighbour(spec, ix, iy, it, [&](std::size_t u) {
-          int x = 0;
-          int y = 0;
-          int t = 0;
-          spec.unindex(u, x, y, t);
-          expected = expected || set.test(x, y, t);
-        });
-        ASSERT_EQ(dilated.test(ix, iy, it), expected) << ix << " " << iy << " " << it;
-      }
-    }
-  }
-  // Padding bits stay clear.
-  EXPECT_EQ(dilated.row(0, 0)[1] >> 6, 0u);
-}
-
-TEST(DistanceTable, SamplesAndBlocksMatchBruteForce)
-{
-  const auto map = test::lRoomMap();
-  const GridSpec spec = GridSpec::fromMap(map->map(), 24, 20);
-  const DistanceTable table = DistanceTable::build(*map, spec, 2);
-  std::mt19937_64 rng(1);
-  for (int trial = 0; trial < 2000; ++trial)
-  {
-    const int ix = static_cast<int>(rng() % spec.nx);
-    const int iy = static_cast<int>(rng() % spec.ny);
-    const int it = static_cast<int>(rng() % spec.nt);
-    const Pose2 centre = spec.centre(spec.index(ix, iy, it));
-    const float value = table.at(ix, iy, it);
-    if (map->isFree(centre.position()))
-    {
-      EXPECT_FLOAT_EQ(value, static_cast<float>(map->range(centre)));
-    }
-    else
-    {
-      EXPECT_TRUE(std::isnan(value));
-    }
-    float lo = std::numeric_limits<float>::infinity();
-    float hi = -lo;
-    if (ix + 1 < spec.nx && iy + 1 < spec.ny)
-    {
-      for (int dt = 0; dt < 2; ++dt)
-      {
-        for (int dy = 0; dy < 2; ++dy)
-        {
-          for (int dx = 0; dx < 2; ++dx)
-          {
-            const float h = table.at(ix + dx, iy + dy, (it + dt) % spec.nt);
-            if (!std::isnan(h))
-            {
-              lo = std::min(lo, h);
-              hi = std::max(hi, h);
-            }
-          }
-        }
-      }
-    }
-    const std::size_t v = spec.index(ix, iy, it);
-    EXPECT_EQ(table.blockMin()[v], lo);
-    EXPECT_EQ(table.blockMax()[v], hi);
-  }
-}
-
-TEST(VoxelEngine, CountingEqualsSubsetEnumeration)
-{
-  const auto map = test::lRoomMap();
-  LocalizerOptions options;
-  options.resolution = 24;
-  VoxelEngine engine(map, options);
-  const int k = 8;
-  const int kp = 5;
-  std::mt19937_64 rng(9);
-  const Pose2 truth = test::randomFreePose(*map, rng);
-  std::vector<Reading> readings = test::exactReadings(*map, truth, test::inPlaceOffsets(k));
-  readings[1].range *= 0.5;  // two obstacle hits
-  readings[6].range *= 0.7;
-  const std::vector<VoxelSet> sets = engine.preimages(readings);
-  std::vector<std::uint8_t> count;
-  engine.countField(sets, count);
-
-  VoxelSet by_enumeration(engine.grid());
-  int subsets = 0;
-  for (unsigned mask = 0; mask < (1u << k); ++mask)
-  {
-    if (__builtin_popcount(mask) != kp)
-    {
-      continue;
-    }
-    ++subsets;
-    VoxelSet intersection = sets[__builtin_ctz(mask)];
-    for (int i = 0; i < k; ++i)
-    {
-      if (mask & (1u << i))
-      {
-        intersection &= sets[i];
-      }
-    }
-    by_enumeration |= intersection;
-  }
-  ASSERT_EQ(subsets, 56);
-  VoxelSet by_count(engine.grid());
-  const GridSpec& spec = engine.grid();
-  for (std::size_t v = 0; v < count.size(); ++v)
-  {
-    int ix = 0;
-    int iy = 0;
-    int it = 0;
-    spec.unindex(v, ix, iy, it);
-    if (count[v] >= kp)
-    {
-      by_count.set(ix, iy, it);
-    }
-    int members = 0;
-    for (const VoxelSet& s : sets)
-    {
-      members += s.test(ix, iy, it) ? 1 : 0;
-    }
-    ASSERT_EQ(count[v], members);
-  }
-  EXPECT_GT(by_count.count(), 0u);
-  EXPECT_TRUE(by_count == by_enumeration);
-}
+using test::smallSpec;
 
 TEST(Components, PeriodicInThetaWithCircularMean)
 {
@@ -253,12 +70,10 @@ TEST(Components, EveryCountPeakBecomesItsOwnSeed)
   EXPECT_EQ(componentSize(spec, count, 4, spec.index(3, 2, 3)), 15u);
 }
 
-TEST(HypothesisSeeds, MaximalSetsMatchBruteForce)
+/// Six readings' voxel sets, each a union of six random 5 x 5 x 3 blobs (periodic in theta).
+std::vector<VoxelSet> randomBlobSets(const GridSpec& spec, std::uint64_t seed)
 {
-  // Random blobs of 6 readings on a small periodic grid; the kept voxels must be exactly those
-  // no neighbour strictly extends, grouped into connected plateaus of identical membership.
-  const GridSpec spec = smallSpec(12, 10, 8);
-  std::mt19937_64 rng(5);
+  std::mt19937_64 rng(seed);
   std::vector<VoxelSet> sets(6, VoxelSet(spec));
   std::uniform_int_distribution<int> ux(0, spec.nx - 1);
   std::uniform_int_distribution<int> uy(0, spec.ny - 1);
@@ -287,7 +102,39 @@ TEST(HypothesisSeeds, MaximalSetsMatchBruteForce)
       }
     }
   }
-  auto maskOf = [&](std::size_t v) {
+  return sets;
+}
+
+/// The voxels at @p level that no neighbour strictly extends (brute force over masks).
+std::set<std::size_t> undominatedVoxels(const GridSpec& spec, const std::vector<std::size_t>& voxels,
+                                        const std::function<unsigned(std::size_t)>& maskOf)
+{
+  std::set<std::size_t> expected;
+  for (std::size_t v : voxels)
+  {
+    int ix = 0;
+    int iy = 0;
+    int it = 0;
+    spec.unindex(v, ix, iy, it);
+    bool dominated = false;
+    forEachNeighbour(spec, ix, iy, it, [&](std::size_t u) {
+      dominated = dominated || ((maskOf(u) & maskOf(v)) == maskOf(v) && maskOf(u) != maskOf(v));
+    });
+    if (!dominated)
+    {
+      expected.insert(v);
+    }
+  }
+  return expected;
+}
+
+TEST(HypothesisSeeds, MaximalSetsMatchBruteForce)
+{
+  // Random blobs of 6 readings on a small periodic grid; the kept voxels must be exactly those
+  // no neighbour strictly extends, grouped into connected plateaus of identical membership.
+  const GridSpec spec = smallSpec(12, 10, 8);
+  const std::vector<VoxelSet> sets = randomBlobSets(spec, 5);
+  const std::function<unsigned(std::size_t)> maskOf = [&](std::size_t v) {
     int ix = 0;
     int iy = 0;
     int it = 0;
@@ -308,22 +155,7 @@ TEST(HypothesisSeeds, MaximalSetsMatchBruteForce)
   int plateaus = 0;
   for (int level = 2; level <= 6; ++level)
   {
-    std::set<std::size_t> expected;
-    for (std::size_t v : buckets[level])
-    {
-      int ix = 0;
-      int iy = 0;
-      int it = 0;
-      spec.unindex(v, ix, iy, it);
-      bool dominated = false;
-      forEachNeighbour(spec, ix, iy, it, [&](std::size_t u) {
-        dominated = dominated || ((maskOf(u) & maskOf(v)) == maskOf(v) && maskOf(u) != maskOf(v));
-      });
-      if (!dominated)
-      {
-        expected.insert(v);
-      }
-    }
+    const std::set<std::size_t> expected = undominatedVoxels(spec, buckets[level], maskOf);
     std::set<std::size_t> kept;
     for (const HypothesisSeed& seed : maximalHypotheses(spec, sets, count, level, buckets[level], 2))
     {
@@ -350,99 +182,6 @@ TEST(HypothesisSeeds, MaximalSetsMatchBruteForce)
     EXPECT_EQ(kept, expected) << "level " << level;
   }
   EXPECT_GT(plateaus, 10);
-}
-
-TEST(TableCache, RoundTripAndEveryKindOfDamageIsRejected)
-{
-  const auto map = test::lRoomMap();
-  const GridSpec spec = GridSpec::fromMap(map->map(), 20, 16);
-  const DistanceTable table = DistanceTable::build(*map, spec, 1);
-  const std::string dir = tempDir("cache");
-  const std::uint64_t hash = map->map().hash();
-  const std::string path = tableCachePath(dir, hash, spec);
-  ASSERT_TRUE(saveTable(path, hash, table));
-  DistanceTable loaded;
-  std::string why;
-  ASSERT_TRUE(loadTable(path, hash, spec, loaded, &why)) << why;
-  ASSERT_EQ(loaded.values().size(), table.values().size());
-  EXPECT_EQ(0, std::memcmp(loaded.values().data(), table.values().data(), table.values().size() * sizeof(float)));
-
-  EXPECT_FALSE(loadTable(path, hash + 1, spec, loaded, &why));
-  GridSpec other = spec;
-  other.nt += 1;
-  EXPECT_FALSE(loadTable(path, hash, other, loaded, &why));
-
-  const auto size = std::filesystem::file_size(path);
-  // A flipped byte in the data.
-  {
-    std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
-    f.seekp(static_cast<std::streamoff>(size / 2));
-    char c = 0;
-    f.read(&c, 1);
-    f.seekp(static_cast<std::streamoff>(size / 2));
-    c = static_cast<char>(c ^ 0x10);
-    f.write(&c, 1);
-  }
-  EXPECT_FALSE(loadTable(path, hash, spec, loaded, &why));
-  EXPECT_NE(why.find("checksum"), std::string::npos) << why;
-  // Truncated.
-  ASSERT_TRUE(saveTable(path, hash, table));
-  std::filesystem::resize_file(path, size - 100);
-  EXPECT_FALSE(loadTable(path, hash, spec, loaded, &why));
-  EXPECT_NE(why.find("truncated"), std::string::npos) << why;
-  // Garbage.
-  {
-    std::ofstream f(path, std::ios::binary | std::ios::trunc);
-    f << "not a table";
-  }
-  EXPECT_FALSE(loadTable(path, hash, spec, loaded, &why));
-  // No temporary files are left behind.
-  int files = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(dir))
-  {
-    (void)entry;
-    ++files;
-  }
-  EXPECT_EQ(files, 1);
-  std::filesystem::remove_all(dir);
-}
-
-TEST(TableCache, CorruptCacheIsRebuiltAndGivesIdenticalResults)
-{
-  const auto map = test::lRoomMap();
-  const std::string dir = tempDir("rebuild");
-  LocalizerOptions options;
-  options.resolution = 40;
-  options.cache_dir = dir;
-  const Pose2 truth(6.2, 3.1, 0.7);
-  const std::vector<Reading> readings = test::exactReadings(*map, truth, test::inPlaceOffsets(10));
-
-  auto run = [&](TableSource expected_source) {
-    VoxelEngine engine(map, options);
-    engine.prepare();
-    EXPECT_EQ(engine.tableSource(), expected_source) << engine.cacheMessage();
-    return engine.localize(readings);
-  };
-  const Result first = run(TableSource::BuiltAndSaved);
-  const Result loaded = run(TableSource::Loaded);
-  const std::string path = tableCachePath(dir, map->map().hash(), GridSpec::fromMap(map->map(), 40, 0));
-  std::filesystem::resize_file(path, std::filesystem::file_size(path) / 3);
-  const Result rebuilt = run(TableSource::Rebuilt);
-  const Result reloaded = run(TableSource::Loaded);
-  for (const Result* r : { &loaded, &rebuilt, &reloaded })
-  {
-    ASSERT_EQ(r->candidates.size(), first.candidates.size());
-    for (std::size_t i = 0; i < first.candidates.size(); ++i)
-    {
-      EXPECT_EQ(r->candidates[i].pose.x, first.candidates[i].pose.x);
-      EXPECT_EQ(r->candidates[i].pose.y, first.candidates[i].pose.y);
-      EXPECT_EQ(r->candidates[i].pose.theta, first.candidates[i].pose.theta);
-      EXPECT_EQ(r->candidates[i].inlier_mask, first.candidates[i].inlier_mask);
-    }
-  }
-  ASSERT_FALSE(first.candidates.empty());
-  EXPECT_LT(test::positionError(first.candidates[0].pose, truth), 1e-3);
-  std::filesystem::remove_all(dir);
 }
 
 TEST(LocalizerInput, BadInputIsAClearError)
@@ -485,7 +224,13 @@ TEST(LocalizerInput, BadInputIsAClearError)
   too_many.min_inliers = 6;
   Localizer strict(map, too_many);
   EXPECT_THROW(strict.localize(good), InvalidInput);
+}
 
+TEST(LocalizerInput, BadOptionsAreAClearError)
+{
+  const auto map = test::lRoomMap();
+  LocalizerOptions options;
+  options.resolution = 24;
   for (int n : { 15, 1025, 0, -3 })
   {
     LocalizerOptions o = options;

@@ -53,6 +53,7 @@ public:
         e.sensor_in_odom = core::compose(e.odom_base, sensor.mount);
         e.range = r.range;
         e.max_range = sensor.max_range;
+        e.half_angle = 0.5 * sensor.fov;  // the simulator reads a cone when fov > 0
         e.obstacle = r.kind == core::SceneHit::Kind::Obstacle;
         e.time = r.time;
         window_.push_back(e);
@@ -81,7 +82,7 @@ private:
   struct Entry
   {
     core::Pose2 odom_base, truth_base, sensor_in_odom;
-    double range = 0.0, max_range = 0.0, time = 0.0;
+    double range = 0.0, max_range = 0.0, half_angle = 0.0, time = 0.0;
     bool obstacle = false;
   };
 
@@ -98,6 +99,7 @@ private:
       reading.offset = core::between(batch->reference, e.sensor_in_odom);
       reading.range = e.range;
       reading.max_range = e.max_range;
+      reading.half_angle = e.half_angle;
       batch->readings.push_back(reading);
       batch->obstacle_hits += e.obstacle ? 1 : 0;
     }
@@ -110,7 +112,7 @@ private:
   std::deque<Entry> window_;
 };
 
-/// Four range sensors (front, left, back, right) at @p rate [Hz].
+/// Four range sensors (front, left, back, right), rays, at @p rate [Hz].
 inline std::vector<core::SensorConfig> fourSensors(double rate, double max_range, double noise)
 {
   std::vector<core::SensorConfig> sensors;
@@ -124,6 +126,7 @@ inline std::vector<core::SensorConfig> fourSensors(double rate, double max_range
     s.rate = rate;
     s.max_range = max_range;
     s.noise_sigma = noise;
+    s.fov = 0.0;  // rays (the tracker's drives before cones were modelled)
     sensors.push_back(s);
   }
   return sensors;

@@ -256,8 +256,7 @@ IndependentCast castWithObstacles(const core::Pose2& sensor, double half_angle, 
     double d = core::kInf;
     if (o.type == visualization_msgs::Marker::CYLINDER)
     {
-      d = core::rayCircleDistance(sensor.position(), sensor.heading(), core::Vec2(o.pose.position.x, o.pose.position.y),
-                                  0.5 * o.scale.x);
+      d = core::sectorCircleDistance(sector, core::Vec2(o.pose.position.x, o.pose.position.y), 0.5 * o.scale.x);
     }
     for (std::size_t k = 0; o.type != visualization_msgs::Marker::CYLINDER && k + 1 < o.points.size(); ++k)
     {

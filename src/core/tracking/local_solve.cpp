@@ -112,6 +112,13 @@ LocalSolveOutcome localSolve(const MapRayCaster& map, const BoxOccupancy& occupa
   }
   outcome.fixes =
       rankAndDeduplicate(std::move(fixes), 2.0 * settings.cell_xy, 2.0 * settings.cell_theta, settings.max_seeds + 1);
+  // A fix at the end of a continuum of exact poses (a corridor's axis, a heading the readings
+  // barely see) must not claim the polish's local precision: the tracker fuses it with the
+  // prediction by these covariances.
+  for (Candidate& fix : outcome.fixes)
+  {
+    widenAlongContinua(map, readings, refine.noise_sigma, fix);
+  }
   return outcome;
 }
 

@@ -22,6 +22,20 @@ int uniformInt(std::mt19937_64& rng, int n)
   return std::min(n - 1, static_cast<int>(uniform(rng) * n));
 }
 
+/// Largest number of cells rasterize() makes (1e9: about 1 GB of grid).
+constexpr double kMaxRasterCells = 1e9;
+
+/// ceil(@p cells) as an int, range-checked: at most kMaxRasterCells.
+int cellCount(double cells, const char* what)
+{
+  if (!(cells >= 0.0 && cells <= kMaxRasterCells))
+  {
+    throw std::invalid_argument(std::string("rasterize: the grid's ") + what + " of " + std::to_string(cells) +
+                                " cells is out of range (at most 1e9): use a coarser resolution");
+  }
+  return static_cast<int>(std::ceil(cells));
+}
+
 void checkOptions(const RasterizeOptions& o)
 {
   if (!(std::isfinite(o.resolution) && o.resolution > 0.0))
@@ -201,14 +215,19 @@ OccupancyGrid rasterize(const PolygonMap& map, const RasterizeOptions& options)
   grid.resolution = res;
   const Box2& bounds = map.bounds();
   grid.origin = Pose2(bounds.min.x() - options.margin, bounds.min.y() - options.margin, 0.0);
-  grid.width = static_cast<int>(std::ceil((bounds.size().x() + 2.0 * options.margin) / res));
-  grid.height = static_cast<int>(std::ceil((bounds.size().y() + 2.0 * options.margin) / res));
+  grid.width = cellCount((bounds.size().x() + 2.0 * options.margin) / res, "width");
+  grid.height = cellCount((bounds.size().y() + 2.0 * options.margin) / res, "height");
+  if (static_cast<double>(grid.width) * grid.height > kMaxRasterCells)
+  {
+    throw std::invalid_argument("rasterize: " + std::to_string(grid.width) + " x " + std::to_string(grid.height) +
+                                " cells is too many (at most 1e9): use a coarser resolution");
+  }
   grid.cells.assign(static_cast<std::size_t>(grid.width) * grid.height, -1);
 
   // Free cells: centre inside the free space (even-odd over every ring's edges).
   fillInside(&grid, map.rings(), 0);
   // Walls: non-free cells within wall_thickness of a free cell.
-  markWalls(&grid, static_cast<int>(std::ceil(options.wall_thickness / res)));
+  markWalls(&grid, cellCount(options.wall_thickness / res, "wall thickness"));
   if (options.fill_obstacles)
   {
     // A floor plan: every non-free cell inside the outer boundary is occupied.

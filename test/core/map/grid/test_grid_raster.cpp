@@ -57,5 +57,24 @@ TEST(GridRaster, FloorPlanFillsObstaclesAndKeepsTheOutsideUnknown)
   EXPECT_LT(free_cells * 0.05 * 0.05, 1.84 + 7.6 * 0.05);
 }
 
+TEST(GridRaster, AGridTooLargeForAnIntIsRefusedWithAMessage)
+{
+  // A 2 x 1 m map at 1e-9 m cells: 2e9 cells a side overflowed an int before.
+  RasterizeOptions options;
+  options.resolution = 1e-9;
+  try
+  {
+    rasterize(roomWithPillar(), options);
+    ADD_FAILURE() << "no error";
+  }
+  catch (const std::invalid_argument& e)
+  {
+    EXPECT_NE(std::string(e.what()).find("coarser resolution"), std::string::npos) << e.what();
+  }
+  options.resolution = 0.05;
+  options.wall_thickness = 1e300;
+  EXPECT_THROW(rasterize(roomWithPillar(), options), std::invalid_argument);
+}
+
 }  // namespace core
 }  // namespace fdml_localization

@@ -6,6 +6,8 @@
 #include "fdml_localization/io/map_files.h"
 #include "fuzz_mutator.h"
 
+#include "temp_dir_test.h"
+
 #include <gtest/gtest.h>
 #include <stb/stb_image_write.h>
 #include <unistd.h>
@@ -24,25 +26,8 @@ namespace
 namespace fs = std::filesystem;
 using core::MapError;
 
-class FuzzMaps : public ::testing::Test
-{
-protected:
-  void SetUp() override
-  {
-    dir_ = fs::temp_directory_path() / ("fdml_fuzz_maps_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override
-  {
-    fs::remove_all(dir_);
-  }
-  std::string file(const std::string& name) const
-  {
-    return (dir_ / name).string();
-  }
-  fs::path dir_;
-};
+class FuzzMaps : public fdml_localization::test::TempDirTest
+{};
 
 std::vector<std::string> bundledPolyTexts()
 {

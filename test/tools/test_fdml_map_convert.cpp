@@ -1,6 +1,8 @@
 // The fdml_map_convert and fdml_map_rasterize tools: outputs, exit codes and error messages.
 #include "fdml_localization/core/map/map_io.h"
 
+#include "temp_dir_test.h"
+
 #include <gtest/gtest.h>
 #include <stb/stb_image.h>
 #include <sys/wait.h>
@@ -17,25 +19,9 @@ namespace core = fdml_localization::core;
 
 namespace
 {
-class MapToolsCli : public ::testing::Test
+class MapToolsCli : public fdml_localization::test::TempDirTest
 {
 protected:
-  void SetUp() override
-  {
-    dir_ = fs::temp_directory_path() / ("fdml_map_tools_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override
-  {
-    fs::remove_all(dir_);
-  }
-
-  std::string file(const std::string& name) const
-  {
-    return (dir_ / name).string();
-  }
-
   /// Runs a tool; returns its exit code and fills @p out and @p err.
   int run(const std::string& exe, const std::string& args, std::string* out, std::string* err)
   {
@@ -49,8 +35,6 @@ protected:
     *err = e.str();
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   }
-
-  fs::path dir_;
 };
 
 const std::string kMaps = std::string(FDML_SOURCE_DIR) + "/maps/";

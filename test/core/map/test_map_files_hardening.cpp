@@ -5,6 +5,8 @@
 #include "fdml_localization/io/map_files.h"
 #include "fdml_localization/io/map_image.h"
 
+#include "temp_dir_test.h"
+
 #include <gtest/gtest.h>
 #include <stb/stb_image_write.h>
 #include <sys/stat.h>
@@ -21,28 +23,9 @@ namespace
 namespace fs = std::filesystem;
 using core::MapError;
 
-class MapFilesHardening : public ::testing::Test
+class MapFilesHardening : public fdml_localization::test::TempDirTest
 {
 protected:
-  void SetUp() override
-  {
-    dir_ = fs::temp_directory_path() / ("fdml_map_hardening_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override
-  {
-    fs::remove_all(dir_);
-  }
-  std::string file(const std::string& name) const
-  {
-    return (dir_ / name).string();
-  }
-  std::string write(const std::string& name, const std::string& bytes) const
-  {
-    std::ofstream(file(name), std::ios::binary) << bytes;
-    return file(name);
-  }
   /// A map_server YAML naming @p image.
   std::string yaml(const std::string& image) const
   {
@@ -64,7 +47,6 @@ protected:
     io::saveOccupancyGridYaml(file("map.yaml"), grid);
     return file("map.yaml");
   }
-  fs::path dir_;
 };
 
 /// Expects a MapError from @p load whose file is @p path, whose line is @p line (-1: any) and

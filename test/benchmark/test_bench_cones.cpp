@@ -5,6 +5,8 @@
 #include "fdml_localization/benchmark/benchmark_protocol.h"
 #include "fdml_localization/core/map/map_io.h"
 
+#include "localizer_test_utils.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -15,12 +17,6 @@ namespace core = fdml_localization::core;
 
 namespace
 {
-std::shared_ptr<const core::MapRayCaster> apartment()
-{
-  return std::make_shared<const core::MapRayCaster>(core::loadPolyFile(std::string(FDML_SOURCE_DIR) + "/maps/"
-                                                                                                      "apartment."
-                                                                                                      "poly"));
-}
 
 /// The nearest entry into the disc over a fan of rays spanning the cone (an upper bound).
 double discFan(const core::Pose2& sensor, double half_angle, const core::Obstacle& disc)
@@ -39,7 +35,7 @@ double discFan(const core::Pose2& sensor, double half_angle, const core::Obstacl
 
 TEST(BenchCones, ConeReadingsAreTheNearestPointInTheCone)
 {
-  const auto map = apartment();
+  const auto map = core::test::loadMap("maps/apartment.poly");
   core::ProtocolOptions options;
   options.obstacles = 30;
   options.half_angle = 0.5 * 27.0 * core::kPi / 180.0;
@@ -80,7 +76,7 @@ TEST(BenchCones, ConeReadingsAreTheNearestPointInTheCone)
 
 TEST(BenchCones, ConesKeepTheTrialAndOnlyShortenTheReadings)
 {
-  const auto map = apartment();
+  const auto map = core::test::loadMap("maps/apartment.poly");
   core::ProtocolOptions rays;
   rays.obstacles = 10;
   rays.translate = true;
@@ -113,7 +109,7 @@ TEST(BenchCones, RejectsHalfAnglesOutsideTheHalfPlane)
   {
     options.half_angle = bad;
     EXPECT_EQ(core::validate(options).size(), 1u) << bad;
-    EXPECT_THROW(core::generateTrial(apartment(), options, 1), std::invalid_argument);
+    EXPECT_THROW(core::generateTrial(core::test::loadMap("maps/apartment.poly"), options, 1), std::invalid_argument);
   }
   options.half_angle = core::kMaxConeHalfAngle;
   EXPECT_TRUE(core::validate(options).empty());

@@ -109,7 +109,11 @@ PoseEvaluation evaluatePose(const MapRayCaster& map, const Pose2& pose, const st
 Candidate verifiedCandidate(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings,
                             double eps)
 {
-  const PoseEvaluation eval = evaluatePose(map, pose, readings, eps);
+  return candidateFrom(pose, evaluatePose(map, pose, readings, eps));
+}
+
+Candidate candidateFrom(const Pose2& pose, const PoseEvaluation& eval)
+{
   Candidate c;
   c.pose = Pose2(pose.x, pose.y, wrapAngle(pose.theta));
   c.inlier_mask = eval.inlier_mask;

@@ -333,12 +333,7 @@ void Refiner::multiStart()
 
 Candidate Refiner::candidate() const
 {
-  Candidate c;
-  c.pose = Pose2(best_pose_.x, best_pose_.y, wrapAngle(best_pose_.theta));
-  c.inlier_mask = best_.inlier_mask;
-  c.inliers = best_.inliers;
-  c.contradicted = best_.contradicted;
-  c.rms_residual = best_.rms;
+  Candidate c = candidateFrom(best_pose_, best_);
   c.covariance = best_cov_;
   return c;
 }

@@ -1,6 +1,8 @@
 // Tests of the local solve: the box search restricted to a region (AdaptiveSearchOptions::region)
 // never loses a pose of the box that explains the readings, and a box without one holds no fix.
 #include "fdml_localization/core/map/map_io.h"
+
+#include "localizer_test_utils.h"
 #include "fdml_localization/core/tracking/local_solve.h"
 
 #include <gtest/gtest.h>
@@ -13,12 +15,6 @@ namespace core = fdml_localization::core;
 
 namespace
 {
-std::shared_ptr<const core::MapRayCaster> apartment()
-{
-  return std::make_shared<const core::MapRayCaster>(core::loadPolyFile(std::string(FDML_SOURCE_DIR) + "/maps/"
-                                                                                                      "apartment."
-                                                                                                      "poly"));
-}
 
 /// k readings from @p truth: four sensors at several headings of a turn.
 std::vector<core::Reading> readingsAt(const core::MapRayCaster& map, const core::Pose2& truth, int k)
@@ -43,7 +39,7 @@ core::PoseBox around(const core::Pose2& p, double xy, double theta)
 
 TEST(LocalSolve, FindsTheTruthInEveryBoxHoldingIt)
 {
-  const auto map = apartment();
+  const auto map = core::test::loadMap("maps/apartment.poly");
   const core::BoxOccupancy occupancy(*map, 0.05);
   core::LocalSolveSettings settings;
   settings.min_consensus = 8;
@@ -71,7 +67,7 @@ TEST(LocalSolve, FindsTheTruthInEveryBoxHoldingIt)
 
 TEST(LocalSolve, RegionSearchKeepsEveryLeafTheWholeSearchKeeps)
 {
-  const auto map = apartment();
+  const auto map = core::test::loadMap("maps/apartment.poly");
   const core::BoxOccupancy occupancy(*map, 0.1);
   const core::Pose2 truth(3.0, 2.5, 0.7);
   const auto readings = readingsAt(*map, truth, 8);

@@ -138,6 +138,9 @@ std::vector<double> vertexMargins(const MapRayCaster& map, const Pose2& pose, co
 void widenAlongContinua(const MapRayCaster& map, const std::vector<Reading>& readings, double noise,
                         Candidate& candidate);
 
+/// A candidate at @p pose with the agreement @p eval (inliers, contradicted, RMS); no covariance.
+Candidate candidateFrom(const Pose2& pose, const PoseEvaluation& eval);
+
 /// A candidate at @p pose, verified but not polished.
 Candidate verifiedCandidate(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings,
                             double eps);

@@ -8,6 +8,8 @@
  *        fdml_map_rasterize --help
  * Exit status: 0 on success (and for --help), 2 on bad arguments or bad input.
  */
+#include "in_out_arguments.h"
+
 #include "fdml_localization/core/map/grid/grid_raster.h"
 #include "fdml_localization/core/util/text_parsing.h"
 #include "fdml_localization/core/map/map_io.h"
@@ -116,40 +118,12 @@ bool applyFlag(const std::string& arg, const std::function<std::string()>& value
 Arguments parseArguments(int argc, char** argv)
 {
   Arguments args;
-  int positional = 0;
-  for (int i = 1; i < argc; ++i)
-  {
-    const std::string arg = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc)
-      {
-        throw std::invalid_argument(arg + " needs a value");
-      }
-      return argv[++i];
-    };
-    if (arg == "-h" || arg == "--help")
-    {
-      std::cout << kUsage;
-      std::exit(0);
-    }
-    if (applyFlag(arg, value, args.options))
-    {
-      continue;
-    }
-    if (!arg.empty() && arg[0] == '-')
-    {
-      throw std::invalid_argument("unknown option " + arg);
-    }
-    if (positional >= 2)
-    {
-      throw std::invalid_argument("too many arguments ('" + arg + "')");
-    }
-    (positional++ == 0 ? args.input : args.output) = arg;
-  }
-  if (positional != 2)
-  {
-    throw std::invalid_argument("need IN.poly and OUT.yaml");
-  }
+  fdml_localization::tools::parseInOutArguments(
+      argc, argv, kUsage,
+      [&args](const std::string& flag, const std::function<std::string()>& value) {
+        return applyFlag(flag, value, args.options);
+      },
+      &args.input, &args.output, "need IN.poly and OUT.yaml");
   return args;
 }
 }  // namespace

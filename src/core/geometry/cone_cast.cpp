@@ -14,13 +14,26 @@ namespace
 /// Slack on the pruning tests [m]: a cell on the exact bound is visited.
 constexpr double kPruneSlack = 1e-9;
 
+/// The nearest point of one segment inside a sector (see sectorSegmentNearest).
+struct SectorPoint
+{
+  double distance = kInf;  ///< [m]
+  double t = 0.0;          ///< parameter of the point on the segment, a + t (b - a)
+  int side = 0;            ///< ConeHit::side
+  double lo = 0.0;         ///< the segment's part inside the sector: [lo, hi]
+  double hi = 1.0;
+  int lo_side = 0;  ///< the bounding ray that cut the part at lo (-1 right, +1 left), 0 = the endpoint
+  int hi_side = 0;
+};
+
 double cross(const Vec2& a, const Vec2& b)
 {
   return a.x() * b.y() - a.y() * b.x();
 }
 
-/// Clips the parameter interval [lo, hi] of a + t (b - a) to the half-plane cross(n, p - o) >= 0.
-bool clipHalfPlane(const Vec2& origin, const Vec2& n, const Segment& seg, double& lo, double& hi)
+/// Clips the parameter interval [lo, hi] of a + t (b - a) to the half-plane cross(n, p - o) >= 0;
+/// @p side is recorded in lo_side or hi_side when the boundary line moves that end.
+bool clipHalfPlane(const Vec2& origin, const Vec2& n, const Segment& seg, int side, SectorPoint& out)
 {
   const double fa = cross(n, seg.a - origin);
   const double fb = cross(n, seg.b - origin);
@@ -30,18 +43,40 @@ bool clipHalfPlane(const Vec2& origin, const Vec2& n, const Segment& seg, double
   }
   if (fa >= 0.0 && fb >= 0.0)
   {
-    return lo <= hi;
+    return out.lo <= out.hi;
   }
   const double t = fa / (fa - fb);  // where the segment crosses the boundary line
-  if (fa < 0.0)
+  if (fa < 0.0 && t > out.lo)
   {
-    lo = std::max(lo, t);
+    out.lo = t;
+    out.lo_side = side;
   }
-  else
+  else if (fa >= 0.0 && t < out.hi)
   {
-    hi = std::min(hi, t);
+    out.hi = t;
+    out.hi_side = side;
   }
-  return lo <= hi;
+  return out.lo <= out.hi;
+}
+
+/// The nearest point of @p seg inside the sector: its distance, where it lies on the segment
+/// and on which bounding ray (ConeHit::side).
+SectorPoint sectorSegmentNearest(const Sector& sector, const Segment& seg)
+{
+  SectorPoint out;
+  if (!clipHalfPlane(sector.origin, sector.right, seg, -1, out) ||
+      !clipHalfPlane(sector.origin, -sector.left, seg, 1, out))
+  {
+    return out;
+  }
+  // The nearest point of the clipped part: the perpendicular foot clamped to it.
+  const Vec2 d = seg.b - seg.a;
+  const double len2 = d.squaredNorm();
+  const double foot = len2 > 0.0 ? (sector.origin - seg.a).dot(d) / len2 : out.lo;
+  out.t = std::clamp(foot, out.lo, out.hi);
+  out.side = foot < out.lo ? out.lo_side : (foot > out.hi ? out.hi_side : 0);
+  out.distance = (seg.a + out.t * d - sector.origin).norm();
+  return out;
 }
 
 /// The bounding box of the sector cut at @p radius: the apex, the ends of the bounding rays and
@@ -101,18 +136,7 @@ bool Sector::contains(const Vec2& p) const
 
 double sectorSegmentDistance(const Sector& sector, const Segment& seg)
 {
-  double lo = 0.0;
-  double hi = 1.0;
-  if (!clipHalfPlane(sector.origin, sector.right, seg, lo, hi) ||
-      !clipHalfPlane(sector.origin, -sector.left, seg, lo, hi))
-  {
-    return kInf;
-  }
-  // The nearest point of the clipped part: the perpendicular foot clamped to it.
-  const Vec2 d = seg.b - seg.a;
-  const double len2 = d.squaredNorm();
-  const double t = len2 > 0.0 ? std::clamp((sector.origin - seg.a).dot(d) / len2, lo, hi) : lo;
-  return (seg.a + t * d - sector.origin).norm();
+  return sectorSegmentNearest(sector, seg).distance;
 }
 
 double sectorSegmentDistance(const Vec2& origin, const Vec2& right, const Vec2& left, const Segment& seg)
@@ -149,40 +173,136 @@ double coneRangeBruteForce(const std::vector<Segment>& segments, const Pose2& se
   return best <= max_range ? best : kInf;
 }
 
+namespace
+{
+/// The nearest point found so far: its segment and where it lies on it.
+struct Nearest
+{
+  SectorPoint point;
+  int segment = -1;
+};
+
+/// Makes @p best segment @p index's nearest point in the sector when that one is nearer.
+void keepNearer(const Sector& sector, const std::vector<Segment>& segments, int index, Nearest& best)
+{
+  const SectorPoint p = sectorSegmentNearest(sector, segments[static_cast<std::size_t>(index)]);
+  if (p.distance < best.point.distance)
+  {
+    best.point = p;
+    best.segment = index;
+  }
+}
+
+/// The cone hit of @p best, or a miss beyond @p max_range.
+ConeHit toHit(const std::vector<Segment>& segments, const Nearest& best, double max_range)
+{
+  ConeHit out;
+  if (best.segment >= 0 && best.point.distance <= max_range)
+  {
+    const Segment& seg = segments[static_cast<std::size_t>(best.segment)];
+    out.distance = best.point.distance;
+    out.segment = best.segment;
+    out.side = best.point.side;
+    out.point = seg.a + best.point.t * (seg.b - seg.a);
+  }
+  return out;
+}
+
+/// The central ray as a cone hit (on the ray: side +1).
+ConeHit rayHit(const MapRayCaster& map, const Pose2& sensor, double max_range)
+{
+  ConeHit out;
+  const Vec2 dir = sensor.heading();
+  const RayHit ray = map.cast(sensor.position(), dir, max_range);
+  if (ray.hit() && std::isfinite(ray.distance))
+  {
+    out.distance = ray.distance;
+    out.segment = ray.segment;
+    out.side = 1;
+    out.point = sensor.position() + ray.distance * dir;
+  }
+  return out;
+}
+}  // namespace
+
 double coneRange(const MapRayCaster& map, const Pose2& sensor, double half_angle, double max_range)
+{
+  return coneCast(map, sensor, half_angle, max_range).distance;
+}
+
+ConeHit coneCast(const MapRayCaster& map, const Pose2& sensor, double half_angle, double max_range)
 {
   if (!(half_angle >= 0.0 && half_angle <= kMaxConeHalfAngle))
   {
     throw std::invalid_argument("coneRange: half_angle " + std::to_string(half_angle) + " rad must be in [0, pi/2]");
   }
+  const ConeHit central = rayHit(map, sensor, max_range);
   if (half_angle == 0.0)
   {
-    return map.range(sensor, max_range);
+    return central;
   }
   const Sector sector = Sector::around(sensor, half_angle);
   const SegmentGrid& grid = map.grid();
+  const std::vector<Segment>& segments = grid.segments();
   // The central ray's hit lies in the sector, so the answer is no farther: it bounds the search
   // (the bounding rays' hits would too, but casting them costs more than they save).
-  const double bound = std::min(max_range, map.range(sensor, max_range));
-  const std::vector<Segment>& segments = grid.segments();
+  const double bound = std::min(max_range, central.distance);
+  Nearest best;
   if (!std::isfinite(bound))
   {
-    return coneRangeBruteForce(segments, sensor, half_angle, max_range);
+    for (int i = 0; i < static_cast<int>(segments.size()); ++i)
+    {
+      keepNearer(sector, segments, i, best);
+    }
+    return toHit(segments, best, max_range);
   }
-  double best = kInf;
   grid.forEachCellInBox(sectorBox(sector, bound), [&](const Box2& cell, const int* first, const int* last) {
-    const double limit = std::min(best, bound) + kPruneSlack;
+    const double limit = std::min(best.point.distance, bound) + kPruneSlack;
     if (boxDistanceSquared(sector.origin, cell) > limit * limit || !mayMeetSector(sector, cell))
     {
       return true;
     }
     for (const int* i = first; i != last; ++i)
     {
-      best = std::min(best, sectorSegmentDistance(sector, segments[static_cast<std::size_t>(*i)]));
+      keepNearer(sector, segments, *i, best);
     }
     return true;
   });
-  return best <= max_range ? best : kInf;
+  return toHit(segments, best, max_range);
+}
+
+Eigen::RowVector3d coneRangeDerivative(const MapRayCaster& map, const Pose2& sensor, double half_angle,
+                                       const ConeHit& hit)
+{
+  Eigen::RowVector3d out = Eigen::RowVector3d::Zero();
+  if (hit.segment < 0 || !(hit.distance > 0.0) || !std::isfinite(hit.distance))
+  {
+    return out;
+  }
+  if (hit.side == 0)
+  {
+    // Strictly inside the sector the nearest point stays the nearest as the sector turns; moving
+    // the apex changes its distance along the unit vector to it (the foot slides along the edge,
+    // which changes nothing to first order).
+    const Vec2 to_point = (hit.point - sensor.position()) / hit.distance;
+    out << -to_point.x(), -to_point.y(), 0.0;
+    return out;
+  }
+  // On a bounding ray: the ray cast's derivative, t = n.(a - p) / (n.u).
+  const Segment& seg = map.grid().segments()[static_cast<std::size_t>(hit.segment)];
+  const Vec2 edge = seg.b - seg.a;
+  const double len = edge.norm();
+  const double phi = sensor.theta + hit.side * half_angle;
+  const Vec2 u(std::cos(phi), std::sin(phi));
+  const double nu = len > 0.0 ? cross(edge, u) / len : 0.0;  // n.u with n = edge's left normal
+  if (std::abs(nu) < 1e-6)
+  {
+    return out;
+  }
+  const Vec2 n(-edge.y() / len, edge.x() / len);
+  const Vec2 u_perp(-u.y(), u.x());
+  out << -n.x() / nu, -n.y() / nu, -hit.distance * n.dot(u_perp) / nu;
+  return out;
 }
 
 }  // namespace core

@@ -1,5 +1,5 @@
 // The continuous polish: Levenberg-Marquardt on (x, y, theta) over the exact ray cast (analytic
-// derivative) or the exact cone cast (numeric derivative), with a covariance estimate.
+// derivative) or the exact cone cast (analytic derivative too), with a covariance estimate.
 #include "fdml_localization/core/localization/robust_search.h"
 
 #include "fdml_localization/core/geometry/cone_cast.h"
@@ -18,8 +18,6 @@ namespace
 {
 /// Residual [m] charged to a ray that leaves free space or misses, during the polish.
 constexpr double kPenaltyResidual = 1.0;
-/// Step of the numeric derivative of a cone reading [m] and [rad].
-constexpr double kConeStep = 1e-6;
 
 /// One reading's residual and its derivative with respect to (x, y, theta).
 struct ResidualRow
@@ -81,35 +79,28 @@ ResidualRow rayRow(const MapRayCaster& map, const Pose2& q, const Rotation& rq, 
   return row;
 }
 
-/// A cone reading: forward differences of the exact cone cast (backward where the forward step
-/// leaves free space). Where the nearest point lies strictly inside the sector the heading
-/// derivative vanishes (the reading does not fix it).
-ResidualRow coneRow(const MapRayCaster& map, const Pose2& q, const Reading& reading)
+/// A cone reading: the exact cone cast and its analytic derivative (cone_cast.h). Where the
+/// nearest point lies strictly inside the sector the heading enters only through the sensor's
+/// mounting offset (the reading does not fix it).
+ResidualRow coneRow(const MapRayCaster& map, const Pose2& q, const Rotation& rq, const Reading& reading)
 {
   ResidualRow row;
-  auto cone = [&](double dx, double dy, double dt) {
-    const Pose2 sensor = compose(Pose2(q.x + dx, q.y + dy, q.theta + dt), reading.offset);
-    return map.isFree(sensor.position()) ? coneRange(map, sensor, reading.half_angle) : kInf;
-  };
-  const double h = cone(0.0, 0.0, 0.0);
-  if (!std::isfinite(h))
+  const Pose2 sensor = compose(q, reading.offset);
+  if (!map.isFree(sensor.position()))
+  {
+    return row;
+  }
+  const ConeHit hit = coneCast(map, sensor, reading.half_angle);
+  if (!std::isfinite(hit.distance))
   {
     return row;
   }
   row.valid = true;
-  row.r = h - reading.range;
-  for (int axis = 0; axis < 3; ++axis)
-  {
-    for (const double step : { kConeStep, -kConeStep })
-    {
-      const double shifted = cone(axis == 0 ? step : 0.0, axis == 1 ? step : 0.0, axis == 2 ? step : 0.0);
-      if (std::isfinite(shifted))
-      {
-        row.jacobian(axis) = (shifted - h) / step;
-        break;
-      }
-    }
-  }
+  row.r = hit.distance - reading.range;
+  const Eigen::RowVector3d d = coneRangeDerivative(map, sensor, reading.half_angle, hit);
+  const Vec2 dp_dtheta(-rq.s * reading.offset.x - rq.c * reading.offset.y,
+                       rq.c * reading.offset.x - rq.s * reading.offset.y);
+  row.jacobian << d(0), d(1), d(2) + d(0) * dp_dtheta.x() + d(1) * dp_dtheta.y();
   return row;
 }
 
@@ -135,7 +126,7 @@ System buildSystem(const MapRayCaster& map, const Pose2& q, const std::vector<Re
       continue;
     }
     const ResidualRow row =
-        readings[i].half_angle > 0.0 ? coneRow(map, q, readings[i]) : rayRow(map, q, rq, readings[i], mounts[i]);
+        readings[i].half_angle > 0.0 ? coneRow(map, q, rq, readings[i]) : rayRow(map, q, rq, readings[i], mounts[i]);
     ++sys.used;
     if (!row.valid)
     {

@@ -63,6 +63,33 @@ double sectorCircleDistance(const Sector& sector, const Vec2& centre, double rad
  */
 double coneRange(const MapRayCaster& map, const Pose2& sensor, double half_angle, double max_range = kInf);
 
+/// Where a cone cast found its nearest point.
+struct ConeHit
+{
+  double distance = kInf;     ///< [m]; +inf when nothing lies in the sector within range
+  Vec2 point = Vec2::Zero();  ///< the nearest point [m]
+  int segment = -1;           ///< index of its edge in the map's grid segments, -1 on a miss
+  /// 0: strictly inside the sector (an edge's perpendicular foot or an endpoint); -1 / +1: where
+  /// the right / left bounding ray crosses the edge (a zero half-angle: the ray, +1).
+  int side = 0;
+};
+
+/// coneRange() with where the nearest point lies (the same distance).
+ConeHit coneCast(const MapRayCaster& map, const Pose2& sensor, double half_angle, double max_range = kInf);
+
+/**
+ * @brief The derivative of the cone range at @p hit (from coneCast(map, sensor, half_angle))
+ *        with respect to the sensor's x, y [m] and heading [rad]. A nearest point strictly
+ *        inside the sector: minus the unit vector to it for the position, 0 for the heading
+ *        (turning the sector does not move it: the reading does not fix the heading). On a
+ *        bounding ray: that ray's derivative, -n / (n.u) and -d (n.u_perp) / (n.u), n the edge's
+ *        normal, u the ray's direction.
+ * @return (dd/dx, dd/dy, dd/dtheta); zeros on a miss, at distance 0 or along an edge parallel
+ *         to the bounding ray
+ */
+Eigen::RowVector3d coneRangeDerivative(const MapRayCaster& map, const Pose2& sensor, double half_angle,
+                                       const ConeHit& hit);
+
 /// The same answer by a loop over every segment (reference for tests).
 double coneRangeBruteForce(const std::vector<Segment>& segments, const Pose2& sensor, double half_angle,
                            double max_range = kInf);

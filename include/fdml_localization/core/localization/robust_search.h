@@ -61,7 +61,8 @@ struct PolishOutcome
 /**
  * @brief Nonlinear least squares on the finite-range readings selected by @p use, from
  *        @p start: Levenberg-Marquardt on (x, y, theta) with the analytic derivative of the exact
- *        ray cast (the hit edge's normal). A ray that leaves free space or misses costs a
+ *        ray cast (the hit edge's normal), or of the exact cone cast for a cone reading
+ *        (coneRangeDerivative()). A ray that leaves free space or misses costs a
  *        constant penalty, so the polish does not walk through walls.
  * @param robust_scale Cauchy loss scale [m]; 0 = plain least squares
  * @param noise_sigma lower bound on the residual standard deviation used for the covariance [m]

@@ -32,12 +32,12 @@ def read_rows(paths):
         with open(path, newline="") as f:
             reader = csv.reader(f)
             header = next(reader, None)
-            if header != HEADER:
+            if header is None or header[:len(HEADER)] != HEADER:  # later columns: fov_deg, top_err_*
                 sys.exit("%s: unexpected CSV header %s (expected %s)" % (path, header, ",".join(HEADER)))
             for line_no, fields in enumerate(reader, start=2):
-                if len(fields) != len(HEADER):
-                    sys.exit("%s:%d: expected %d fields, got %d" % (path, line_no, len(HEADER), len(fields)))
-                rows.append(dict(zip(HEADER, fields)))
+                if len(fields) != len(header):
+                    sys.exit("%s:%d: expected %d fields, got %d" % (path, line_no, len(header), len(fields)))
+                rows.append(dict(zip(header, fields)))
     return rows
 
 

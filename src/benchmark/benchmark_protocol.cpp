@@ -327,6 +327,12 @@ TrialScore scoreTrial(const Trial& trial, const Result& result, const Box2& boun
   }
   s.success_paper = s.has_nearest && best <= 2.0 * paperResolutionError(n);
   s.success_top1 = !result.candidates.empty() && strict(result.candidates.front().pose);
+  if (!result.candidates.empty())
+  {
+    const Pose2& top = result.candidates.front().pose;
+    s.top_err_pos = (top.position() - trial.truth.position()).norm();
+    s.top_err_theta = std::abs(angleDiff(top.theta, trial.truth.theta));
+  }
   return s;
 }
 

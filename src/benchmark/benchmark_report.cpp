@@ -62,7 +62,7 @@ const std::vector<std::string>& headers()
 std::string csvHeader()
 {
   return "scene,m,n,method,trial,success_paper,success_strict,success_top1,candidates,time_ms,"
-         "sparsity_held,err_pos,err_theta,fov_deg";
+         "sparsity_held,err_pos,err_theta,fov_deg,top_err_pos,top_err_theta";
 }
 
 std::string csvRow(const BenchRow& r)
@@ -80,7 +80,15 @@ std::string csvRow(const BenchRow& r)
   {
     out << ',';
   }
-  out << ',' << format("%g", r.fov_deg);
+  out << ',' << format("%g", r.fov_deg) << ',';
+  if (s.has_nearest)
+  {
+    out << format("%.6f", s.top_err_pos) << ',' << format("%.6f", s.top_err_theta);
+  }
+  else
+  {
+    out << ',';
+  }
   return out.str();
 }
 

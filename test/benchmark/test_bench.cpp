@@ -193,6 +193,8 @@ TEST(BenchScoring, PaperMetricAndCriteria)
   EXPECT_EQ(s.candidates, 2);
   EXPECT_NEAR(s.err_pos, 0.03, 1e-12);
   EXPECT_NEAR(s.err_theta, 0.02, 1e-12);
+  EXPECT_NEAR(s.top_err_pos, std::hypot(2.0, 0.5), 1e-12);  // the best-ranked one: far
+  EXPECT_NEAR(s.top_err_theta, 0.0, 1e-12);
   EXPECT_EQ(s.time_ms, 12.5);
 
   result.candidates = { near };
@@ -209,8 +211,8 @@ TEST(BenchScoring, PaperMetricAndCriteria)
   s = core::scoreTrial(trial, result, bounds, 100, 6, 1.0);
   EXPECT_FALSE(s.has_nearest);
   EXPECT_FALSE(s.success_paper);
-  EXPECT_EQ(core::csvRow(core::BenchRow{ "a", 1, 2, "robust", 3, s }), "a,1,2,robust,3,0,0,0,0,1.000,1,,,0");
-  EXPECT_EQ(core::csvRow(core::BenchRow{ "a", 1, 2, "robust", 3, s, 27.0 }), "a,1,2,robust,3,0,0,0,0,1.000,1,,,27");
+  EXPECT_EQ(core::csvRow(core::BenchRow{ "a", 1, 2, "robust", 3, s }), "a,1,2,robust,3,0,0,0,0,1.000,1,,,0,,");
+  EXPECT_EQ(core::csvRow(core::BenchRow{ "a", 1, 2, "robust", 3, s, 27.0 }), "a,1,2,robust,3,0,0,0,0,1.000,1,,,27,,");
 }
 
 TEST(BenchReport, SummaryCountsAndQuantiles)
@@ -249,7 +251,7 @@ TEST(BenchReport, SummaryCountsAndQuantiles)
 using CellKey = std::tuple<std::string, int, int, std::string>;
 using CellSums = std::map<CellKey, std::vector<int>>;  // trials, paper, strict, top1
 
-/// Reads the tool's CSV (its header, then rows of 14 fields ending in fov_deg = @p fov), summing
+/// Reads the tool's CSV (its header, then rows of 16 fields, fov_deg = @p fov the 14th), summing
 /// the counts per cell; returns the number of rows.
 int readCsvSums(const std::string& csv, const std::string& fov, CellSums* sums)
 {
@@ -257,13 +259,13 @@ int readCsvSums(const std::string& csv, const std::string& fov, CellSums* sums)
   std::string line;
   EXPECT_TRUE(std::getline(csv_in, line));
   EXPECT_EQ(line, "scene,m,n,method,trial,success_paper,success_strict,success_top1,candidates,time_ms,"
-                  "sparsity_held,err_pos,err_theta,fov_deg");
+                  "sparsity_held,err_pos,err_theta,fov_deg,top_err_pos,top_err_theta");
   int rows = 0;
   while (std::getline(csv_in, line))
   {
     const std::vector<std::string> f = split(line, ',');
-    EXPECT_EQ(f.size(), 14u) << line;
-    if (f.size() != 14u)
+    EXPECT_EQ(f.size(), 16u) << line;
+    if (f.size() != 16u)
     {
       return rows;
     }
@@ -275,7 +277,7 @@ int readCsvSums(const std::string& csv, const std::string& fov, CellSums* sums)
       EXPECT_TRUE(f[5 + c] == "0" || f[5 + c] == "1") << line;
       s[1 + c] += std::stoi(f[5 + c]);
     }
-    EXPECT_EQ(f[11].empty(), f[12].empty()) << line;
+    EXPECT_TRUE(f[11].empty() == f[12].empty() && f[11].empty() == f[14].empty() && f[14].empty() == f[15].empty());
     EXPECT_EQ(f[11].empty(), f[8] == "0") << line;
     EXPECT_EQ(f[13], fov) << line;
     ++rows;

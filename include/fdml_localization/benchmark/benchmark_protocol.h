@@ -90,6 +90,8 @@ struct TrialScore
   bool has_nearest = false;    ///< false when there is no candidate
   double err_pos = 0.0;        ///< nearest candidate's position error [m]
   double err_theta = 0.0;      ///< nearest candidate's absolute heading error [rad]
+  double top_err_pos = 0.0;    ///< best-ranked candidate's position error [m] (has_nearest)
+  double top_err_theta = 0.0;  ///< best-ranked candidate's absolute heading error [rad]
 };
 
 /**

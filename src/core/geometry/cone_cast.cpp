@@ -258,7 +258,7 @@ ConeHit coneCast(const MapRayCaster& map, const Pose2& sensor, double half_angle
   }
   grid.forEachCellInBox(sectorBox(sector, bound), [&](const Box2& cell, const int* first, const int* last) {
     const double limit = std::min(best.point.distance, bound) + kPruneSlack;
-    if (boxDistanceSquared(sector.origin, cell) > limit * limit || !mayMeetSector(sector, cell))
+    if (first == last || boxDistanceSquared(sector.origin, cell) > limit * limit || !mayMeetSector(sector, cell))
     {
       return true;
     }

@@ -225,37 +225,22 @@ ConeHit rayHit(const MapRayCaster& map, const Pose2& sensor, double max_range)
 }
 }  // namespace
 
-double coneRange(const MapRayCaster& map, const Pose2& sensor, double half_angle, double max_range)
+namespace
 {
-  return coneCast(map, sensor, half_angle, max_range).distance;
-}
-
-ConeHit coneCast(const MapRayCaster& map, const Pose2& sensor, double half_angle, double max_range)
+void checkHalfAngle(double half_angle)
 {
   if (!(half_angle >= 0.0 && half_angle <= kMaxConeHalfAngle))
   {
     throw std::invalid_argument("coneRange: half_angle " + std::to_string(half_angle) + " rad must be in [0, pi/2]");
   }
-  const ConeHit central = rayHit(map, sensor, max_range);
-  if (half_angle == 0.0)
-  {
-    return central;
-  }
-  const Sector sector = Sector::around(sensor, half_angle);
-  const SegmentGrid& grid = map.grid();
+}
+
+/// The nearest point of the sector among the edges of the grid cells that meet it within
+/// @p bound [m] (finite): exact when some edge point of the sector lies within the bound.
+Nearest searchSector(const SegmentGrid& grid, const Sector& sector, double bound)
+{
   const std::vector<Segment>& segments = grid.segments();
-  // The central ray's hit lies in the sector, so the answer is no farther: it bounds the search
-  // (the bounding rays' hits would too, but casting them costs more than they save).
-  const double bound = std::min(max_range, central.distance);
   Nearest best;
-  if (!std::isfinite(bound))
-  {
-    for (int i = 0; i < static_cast<int>(segments.size()); ++i)
-    {
-      keepNearer(sector, segments, i, best);
-    }
-    return toHit(segments, best, max_range);
-  }
   grid.forEachCellInBox(sectorBox(sector, bound), [&](const Box2& cell, const int* first, const int* last) {
     const double limit = std::min(best.point.distance, bound) + kPruneSlack;
     if (first == last || boxDistanceSquared(sector.origin, cell) > limit * limit || !mayMeetSector(sector, cell))
@@ -268,7 +253,59 @@ ConeHit coneCast(const MapRayCaster& map, const Pose2& sensor, double half_angle
     }
     return true;
   });
+  return best;
+}
+}  // namespace
+
+double coneRange(const MapRayCaster& map, const Pose2& sensor, double half_angle, double max_range)
+{
+  return coneCast(map, sensor, half_angle, max_range).distance;
+}
+
+ConeHit coneCast(const MapRayCaster& map, const Pose2& sensor, double half_angle, double max_range)
+{
+  checkHalfAngle(half_angle);
+  const ConeHit central = rayHit(map, sensor, max_range);
+  if (half_angle == 0.0)
+  {
+    return central;
+  }
+  const Sector sector = Sector::around(sensor, half_angle);
+  const std::vector<Segment>& segments = map.grid().segments();
+  // The central ray's hit lies in the sector, so the answer is no farther: it bounds the search
+  // (the bounding rays' hits would too, but casting them costs more than they save).
+  const double bound = std::min(max_range, central.distance);
+  if (std::isfinite(bound))
+  {
+    return toHit(segments, searchSector(map.grid(), sector, bound), max_range);
+  }
+  Nearest best;
+  for (int i = 0; i < static_cast<int>(segments.size()); ++i)
+  {
+    keepNearer(sector, segments, i, best);
+  }
   return toHit(segments, best, max_range);
+}
+
+ConeHit coneCast(const MapRayCaster& map, const Pose2& sensor, double half_angle, double max_range, const Vec2& hint)
+{
+  checkHalfAngle(half_angle);
+  if (half_angle > 0.0 && hint.allFinite())
+  {
+    const Sector sector = Sector::around(sensor, half_angle);
+    if (sector.contains(hint))
+    {
+      const double bound = std::min(max_range, (hint - sector.origin).norm());
+      const Nearest best = searchSector(map.grid(), sector, bound);
+      // A map point in the sector bounds the answer, and the search finds it; anything else (a
+      // hint off the map, nothing within max_range) takes the central ray's bound instead.
+      if (best.segment >= 0 && best.point.distance <= bound + kPruneSlack)
+      {
+        return toHit(map.grid().segments(), best, max_range);
+      }
+    }
+  }
+  return coneCast(map, sensor, half_angle, max_range);
 }
 
 Eigen::RowVector3d coneRangeDerivative(const MapRayCaster& map, const Pose2& sensor, double half_angle,

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace fdml_localization
 {
@@ -81,8 +82,9 @@ ResidualRow rayRow(const MapRayCaster& map, const Pose2& q, const Rotation& rq, 
 
 /// A cone reading: the exact cone cast and its analytic derivative (cone_cast.h). Where the
 /// nearest point lies strictly inside the sector the heading enters only through the sensor's
-/// mounting offset (the reading does not fix it).
-ResidualRow coneRow(const MapRayCaster& map, const Pose2& q, const Rotation& rq, const Reading& reading)
+/// mounting offset (the reading does not fix it). @p hint: the reading's last hit point (NaN
+/// before the first), which bounds the cast near the last pose; updated.
+ResidualRow coneRow(const MapRayCaster& map, const Pose2& q, const Rotation& rq, const Reading& reading, Vec2& hint)
 {
   ResidualRow row;
   const Pose2 sensor = compose(q, reading.offset);
@@ -90,11 +92,12 @@ ResidualRow coneRow(const MapRayCaster& map, const Pose2& q, const Rotation& rq,
   {
     return row;
   }
-  const ConeHit hit = coneCast(map, sensor, reading.half_angle);
+  const ConeHit hit = coneCast(map, sensor, reading.half_angle, kInf, hint);
   if (!std::isfinite(hit.distance))
   {
     return row;
   }
+  hint = hit.point;
   row.valid = true;
   row.r = hit.distance - reading.range;
   const Eigen::RowVector3d d = coneRangeDerivative(map, sensor, reading.half_angle, hit);
@@ -114,8 +117,10 @@ struct System
   int used = 0;
 };
 
+/// The normal equations at @p q; @p hints: each cone reading's last hit point (see coneRow).
 System buildSystem(const MapRayCaster& map, const Pose2& q, const std::vector<Reading>& readings,
-                   const std::vector<Rotation>& mounts, const std::vector<bool>& use, double scale)
+                   const std::vector<Rotation>& mounts, const std::vector<bool>& use, double scale,
+                   std::vector<Vec2>& hints)
 {
   System sys;
   const Rotation rq(q.theta);
@@ -125,8 +130,8 @@ System buildSystem(const MapRayCaster& map, const Pose2& q, const std::vector<Re
     {
       continue;
     }
-    const ResidualRow row =
-        readings[i].half_angle > 0.0 ? coneRow(map, q, rq, readings[i]) : rayRow(map, q, rq, readings[i], mounts[i]);
+    const ResidualRow row = readings[i].half_angle > 0.0 ? coneRow(map, q, rq, readings[i], hints[i]) :
+                                                           rayRow(map, q, rq, readings[i], mounts[i]);
     ++sys.used;
     if (!row.valid)
     {
@@ -192,7 +197,8 @@ PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std:
   {
     mounts.emplace_back(r.offset.theta);
   }
-  System sys = buildSystem(map, out.pose, readings, mounts, use, robust_scale);
+  std::vector<Vec2> hints(readings.size(), Vec2::Constant(std::numeric_limits<double>::quiet_NaN()));
+  System sys = buildSystem(map, out.pose, readings, mounts, use, robust_scale, hints);
   double lambda = 1e-3;
   for (int iter = 0; iter < max_iterations && lambda <= 1e8; ++iter)
   {
@@ -207,7 +213,7 @@ PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std:
     // Keep each step local: the model only holds near the current pose (0.5 m, 0.3 rad).
     delta /= std::max({ 1.0, delta.head<2>().norm() / 0.5, std::abs(delta(2)) / 0.3 });
     const Pose2 trial = step(out.pose, delta);
-    const System next = buildSystem(map, trial, readings, mounts, use, robust_scale);
+    const System next = buildSystem(map, trial, readings, mounts, use, robust_scale, hints);
     if (next.cost >= sys.cost)
     {
       lambda *= 4.0;
@@ -221,7 +227,7 @@ PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std:
       break;
     }
   }
-  out.covariance = poseCovariance(map, buildSystem(map, out.pose, readings, mounts, use, 0.0), noise_sigma);
+  out.covariance = poseCovariance(map, buildSystem(map, out.pose, readings, mounts, use, 0.0, hints), noise_sigma);
   return out;
 }
 

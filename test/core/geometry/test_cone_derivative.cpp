@@ -1,7 +1,8 @@
 // Where the cone cast finds its nearest point (coneCast) and the analytic derivative of the cone
 // range (coneRangeDerivative) used by the polish: the point lies on its edge at the cast's
-// distance, inside the sector or on the bounding ray its side names, and the derivative matches
-// central differences of the exact cone cast wherever the cast is smooth.
+// distance, inside the sector or on the bounding ray its side names; a hint (the polish's last
+// hit point) never changes the answer; the derivative matches central differences of the exact
+// cone cast wherever the cast is smooth.
 #include "fdml_localization/core/geometry/cone_cast.h"
 #include "fdml_localization/core/map/map_io.h"
 
@@ -72,6 +73,30 @@ TEST(ConeCastHit, ThePointLiesOnItsEdgeAtTheDistanceAndOnTheNamedSide)
       EXPECT_NEAR(cross(hit.side > 0 ? left : right, hit.point - o), 0.0, 1e-9) << path << " a " << a;
     }
   });
+}
+
+TEST(ConeCastHint, AnyHintGivesTheSameAnswer)
+{
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> jitter(-0.05, 0.05);
+  int bounded = 0;
+  forRandomCones(300, 7, [&](const MapRayCaster& map, const Pose2& sensor, double a, const std::string& path) {
+    const ConeHit exact = coneCast(map, sensor, a);
+    // A map point from a nearby pose (the polish's hint), a point off the map's edges, and none.
+    const Pose2 near(sensor.x + jitter(rng), sensor.y + jitter(rng), sensor.theta + jitter(rng));
+    const Vec2 off_edge = sensor.position() + 0.3 * exact.distance * sensor.heading();
+    for (const Vec2& hint : { coneCast(map, near, a).point, off_edge, Vec2(kInf, 0.0) })
+    {
+      for (const double max_range : { kInf, 0.8 * exact.distance })
+      {
+        const ConeHit hinted = coneCast(map, sensor, a, max_range, hint);
+        ASSERT_EQ(hinted.distance, coneRange(map, sensor, a, max_range)) << path << " a " << a;
+        ASSERT_EQ(hinted.segment < 0, std::isinf(hinted.distance)) << path;
+      }
+    }
+    bounded += Sector::around(sensor, a).contains(coneCast(map, near, a).point) ? 1 : 0;
+  });
+  EXPECT_GT(bounded, 300);  // the nearby pose's hit bounds the search often
 }
 
 TEST(ConeRangeDerivative, MatchesCentralDifferencesWhereTheCastIsSmooth)

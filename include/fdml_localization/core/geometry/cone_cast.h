@@ -78,6 +78,15 @@ struct ConeHit
 ConeHit coneCast(const MapRayCaster& map, const Pose2& sensor, double half_angle, double max_range = kInf);
 
 /**
+ * @brief coneCast() bounded by @p hint, a point of a map edge (typically the previous hit of a
+ *        nearby pose, as in the polish): when it lies in the sector its distance bounds the
+ *        search instead of the central ray's cast, which saves that cast and shrinks the cells
+ *        visited. The same answer for any hint (a hint that is no map point, or NaN, falls back to
+ *        coneCast()).
+ */
+ConeHit coneCast(const MapRayCaster& map, const Pose2& sensor, double half_angle, double max_range, const Vec2& hint);
+
+/**
  * @brief The derivative of the cone range at @p hit (from coneCast(map, sensor, half_angle))
  *        with respect to the sensor's x, y [m] and heading [rad]. A nearest point strictly
  *        inside the sector: minus the unit vector to it for the position, 0 for the heading

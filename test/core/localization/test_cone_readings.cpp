@@ -1,15 +1,19 @@
 // Cone readings (issue 18) in verification, polish and the adaptive box test: the box test
 // stays conservative against a brute force over sampled poses, a zero half-angle is exactly the
-// ray, the polish finds the position of cone readings and says through the covariance when the
-// heading is undetermined, and the adaptive engine keeps the truth with cone readings.
+// ray, the polish (and the localizer's candidate) finds the position of cone readings and says
+// through the covariance when the heading is undetermined, and the adaptive engine keeps the
+// truth with cone readings.
 #include "fdml_localization/core/geometry/cone_cast.h"
 #include "fdml_localization/core/localization/adaptive/adaptive_engine.h"
+#include "fdml_localization/core/localization/localizer.h"
 #include "fdml_localization/core/localization/robust_search.h"
 
 #include "localizer_test_utils.h"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <memory>
 #include <random>
 
 namespace fdml_localization
@@ -149,6 +153,34 @@ TEST(ConePolish, FindsThePositionAndSaysWhenTheHeadingIsUndetermined)
   EXPECT_GT(out.covariance(2, 2), 1.0) << "the heading is undetermined: its variance must be large";
   EXPECT_LT(out.covariance(0, 0), 1e-5);
   EXPECT_LT(out.covariance(1, 1), 1e-5);
+}
+
+TEST(ConeLocalization, FacingFlatWallsTheCandidateSaysTheHeadingIsLoose)
+{
+  // A 5 x 3 m room; four readings 90 deg apart from the robot's centre, each facing a wall. With
+  // 27 deg cones every nearest point is the foot of a perpendicular, inside its sector: the
+  // heading changes no reading in a band of 27 deg, and the returned candidate's covariance must
+  // say so. With 2 deg cones the bounding rays hit the walls and fix the heading.
+  std::vector<Ring> rings{ { Vec2(0, 0), Vec2(5, 0), Vec2(5, 3), Vec2(0, 3) } };
+  const auto map = std::make_shared<const MapRayCaster>(PolygonMap::fromRings(rings, "room"));
+  const Pose2 truth(1.8, 1.2, 0.2);  // 11.5 deg off the walls' normals
+  LocalizerOptions options;
+  options.resolution = 64;
+  options.threads = 1;
+  Localizer localizer(map, options);
+  double variance[2] = { 0.0, 0.0 };
+  for (const int wide : { 1, 0 })
+  {
+    const Result result = localizer.localize(coneReadings(*map, truth, 4, (wide ? 13.5 : 1.0) * kDeg));
+    const Candidate* nearest = test::nearestCandidate(result, truth);
+    ASSERT_NE(nearest, nullptr);
+    EXPECT_LT(test::positionError(nearest->pose, truth), 0.02) << "wide " << wide;
+    EXPECT_LT(test::angleError(nearest->pose, truth), (wide ? 27.0 : 1.0) * kDeg) << "wide " << wide;
+    EXPECT_LT(nearest->covariance(0, 0) + nearest->covariance(1, 1), 1e-3) << "wide " << wide;
+    variance[wide] = nearest->covariance(2, 2);
+  }
+  EXPECT_GT(variance[1], std::pow(20.0 * kDeg, 2)) << "27 deg cones facing walls: the heading is loose";
+  EXPECT_LT(variance[0], std::pow(2.0 * kDeg, 2)) << "2 deg cones: the bounding rays fix the heading";
 }
 
 TEST(ConeLocalization, AdaptiveEngineFindsTheTruthWithConeReadings)

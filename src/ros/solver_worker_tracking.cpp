@@ -80,7 +80,7 @@ bool SolverWorker::needsGlobalSearch(bool relocalizing) const
 
 std::string SolverWorker::globalSearch(const Job& job)
 {
-  const core::Result global = localizer_->localize(job.readings);
+  const core::Result global = global_localizer_->localize(job.readings);
   updates_since_global_ = 0;
   handover_pending_ = true;
   tracker_->seed(global.candidates, job.batch.base_first, 0.0);
@@ -142,6 +142,7 @@ core::Result SolverWorker::trackedResult(const Job& job) const
     core::Candidate c = h.last_fix;
     c.pose = core::compose(h.map_to_odom, job.batch.base_first);
     c.support = h.support;
+    c.covariance = h.covariance;
     c.inlier_mask.resize(job.readings.size(), false);
     result.candidates.push_back(c);
   }

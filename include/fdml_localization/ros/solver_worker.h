@@ -59,6 +59,13 @@ private:
   static std::string describeOutcome(const core::Result& result, bool unambiguous);
   /// The core options for @p map: the parameters, with grid tolerances for a converted grid.
   core::LocalizerOptions optionsFor(const LoadedMap& map) const;
+  /// The adaptive engine within ~global_deadline, otherwise @p options.
+  std::unique_ptr<core::Localizer> globalLocalizerFor(const std::shared_ptr<const core::MapRayCaster>& map,
+                                                      core::LocalizerOptions options) const;
+  /// Builds localizer_'s tables beside the worker (logs when ready).
+  void prepareInBackground();
+  /// Joins the table build started by prepareInBackground().
+  void waitForTables();
   /// The tracker for @p map, with the localizer's tolerances.
   std::unique_ptr<core::HypothesisTracker> trackerFor(const std::shared_ptr<const core::MapRayCaster>& map,
                                                       const core::LocalizerOptions& options) const;
@@ -102,7 +109,13 @@ private:
   ResultPublisher& publisher_;
   std::string map_topic_;
   std::shared_ptr<const core::MapRayCaster> map_;     ///< worker thread only; null until a map
-  std::unique_ptr<core::Localizer> localizer_;        ///< worker thread only; null until a map
+  std::unique_ptr<core::Localizer> localizer_;        ///< worker thread only (~localize); null until a map
+  /// The tracking global searches' localizer: the adaptive engine within ~global_deadline (no
+  /// table to wait for); worker thread only, null until a map
+  std::unique_ptr<core::Localizer> global_localizer_;
+  /// Prepares localizer_ (the voxel engine's table) beside the tracking at start; joined before
+  /// localizer_ is used or replaced (waitForTables())
+  std::thread table_thread_;
   std::unique_ptr<core::HypothesisTracker> tracker_;  ///< worker thread only; null until a map
   std::uint64_t generation_ = 0;                      ///< NodeState::generation of the last batch
   int updates_since_global_ = 0;                      ///< tracking updates since the last global search
@@ -110,7 +123,7 @@ private:
   bool published_empty_ = false;                      ///< the last ~result published had no hypothesis
   bool was_tracking_ = false;                         ///< the last batch had a clearly supported hypothesis
   std::thread thread_;
-  bool cache_warned_ = false;  ///< worker thread only
+  bool cache_warned_ = false;  ///< worker thread, or the table build while it runs
 };
 
 }  // namespace fdml_localization

@@ -70,6 +70,7 @@ LocalSolveOutcome localSolve(const MapRayCaster& map, const BoxOccupancy& occupa
   LocalSolveOutcome outcome;
   const int k = static_cast<int>(readings.size());
   outcome.best_consensus = -k;
+  outcome.least_contradicted = k;
   AdaptiveSearchOptions options;
   options.cell_xy = settings.cell_xy;
   options.cell_theta = settings.cell_theta;
@@ -86,6 +87,9 @@ LocalSolveOutcome localSolve(const MapRayCaster& map, const BoxOccupancy& occupa
   }
   if (found.leaves.empty())
   {
+    // No leaf may explain k' readings: say whether the prediction is contradicted or only hidden.
+    outcome.least_contradicted =
+        evaluatePose(map, box.centre(), readings, settings.agreement_tolerance).contradicted;
     return outcome;
   }
   RefinementSettings refine;
@@ -99,6 +103,7 @@ LocalSolveOutcome localSolve(const MapRayCaster& map, const BoxOccupancy& occupa
   {
     Candidate c = refineSeed(map, start.first, readings, start.second, refine);
     outcome.best_consensus = std::max(outcome.best_consensus, netConsensus(c));
+    outcome.least_contradicted = std::min(outcome.least_contradicted, c.contradicted);
     if (netConsensus(c) >= settings.min_consensus && insideBox(c.pose, box, settings.cell_xy, settings.cell_theta))
     {
       fixes.push_back(std::move(c));

@@ -8,6 +8,7 @@
 
 #include <ros/ros.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <utility>
@@ -38,6 +39,7 @@ SolverWorker::~SolverWorker()
   {
     thread_.join();
   }
+  global_search_.reset();
   waitForTables();
 }
 
@@ -240,12 +242,16 @@ std::unique_ptr<core::HypothesisTracker> SolverWorker::trackerFor(const std::sha
   core::TrackerOptions tracker = params_.tracker;
   tracker.agreement_tolerance = options.agreement_tolerance;
   tracker.range_tolerance = options.range_tolerance;
+  // Successive batches share k - stride readings: each fix counts stride / k of a new one.
+  tracker.fix_covariance_scale =
+      static_cast<double>(params_.measurements_per_batch) / std::max(1, params_.batch_stride);
   return std::make_unique<core::HypothesisTracker>(map, tracker);
 }
 
 void SolverWorker::applyMap(const nav_msgs::OccupancyGrid::ConstPtr& msg)
 {
-  waitForTables();  // the build in progress uses localizer_ (and cache_warned_)
+  waitForTables();          // the build in progress uses localizer_ (and cache_warned_)
+  global_search_.reset();   // waits for a global search in progress (it uses global_localizer_)
   const std::string source = "topic " + map_topic_;
   const auto start = std::chrono::steady_clock::now();
   std::shared_ptr<const core::MapRayCaster> map;

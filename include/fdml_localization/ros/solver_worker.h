@@ -17,6 +17,7 @@
 
 #include <nav_msgs/OccupancyGrid.h>
 
+#include <future>
 #include <memory>
 #include <optional>
 #include <string>
@@ -93,8 +94,11 @@ private:
   void publishTracking(const Job& job, const core::Result& result, const Outcome& outcome);
   /// True when this batch needs a global search (docs/localizer_node.md#tracking).
   bool needsGlobalSearch(bool relocalizing) const;
-  /// Runs the global search on @p job and seeds the tracker with its candidates.
-  std::string globalSearch(const Job& job);
+  /// Starts a global search on @p job's readings beside the tracking (global_search_).
+  void startGlobalSearch(const Job& job);
+  /// Seeds the tracker with the candidates of a finished global search; the event (empty: none
+  /// finished, or it was for hypotheses dropped since by a relocalization request).
+  std::string collectGlobalSearch();
   /// Applies a pose hint to the tracker; the outcome as text.
   std::string applyHint(const PoseHint& hint, const Job& job);
   /// The hypotheses as a core::Result (poses at the batch's first reading), best first.
@@ -116,6 +120,15 @@ private:
   /// Prepares localizer_ (the voxel engine's table) beside the tracking at start; joined before
   /// localizer_ is used or replaced (waitForTables())
   std::thread table_thread_;
+  /// A global search under way beside the tracking (global_localizer_ is used by it alone).
+  struct PendingSearch
+  {
+    std::future<core::Result> result;
+    core::Pose2 reference;        ///< the odometry pose of the base its readings refer to
+    std::uint64_t generation = 0; ///< NodeState::generation it was started in
+    std::size_t readings = 0;
+  };
+  std::optional<PendingSearch> global_search_;  ///< worker thread only
   std::unique_ptr<core::HypothesisTracker> tracker_;  ///< worker thread only; null until a map
   std::uint64_t generation_ = 0;                      ///< NodeState::generation of the last batch
   int updates_since_global_ = 0;                      ///< tracking updates since the last global search

@@ -210,7 +210,7 @@ bool HypothesisTracker::updateOne(Hypothesis& h, const std::vector<Reading>& rea
     }
   }
   const Candidate& fix = found.fixes[chosen];
-  const FusedPose fused = fusePose(predicted, h.covariance, fix.pose, fix.covariance);
+  const FusedPose fused = fusePose(predicted, h.covariance, fix.pose, options_.fix_covariance_scale * fix.covariance);
   h.map_to_odom = compose(fused.pose, inverse(reference));
   h.covariance = fused.covariance;
   h.travelled = 0.0;

@@ -53,6 +53,18 @@ std::vector<std::pair<Pose2, std::vector<bool>>> startsOf(std::vector<LeafBox> l
   }
   return starts;
 }
+AdaptiveSearchOptions searchOptions(const PoseBox& box, const LocalSolveSettings& settings)
+{
+  AdaptiveSearchOptions options;
+  options.cell_xy = settings.cell_xy;
+  options.cell_theta = settings.cell_theta;
+  options.min_count = settings.min_consensus;
+  options.range_tolerance = settings.range_tolerance;
+  options.max_boxes = settings.max_boxes;
+  options.threads = 1;
+  options.region = box;
+  return options;
+}
 }  // namespace
 
 bool insideBox(const Pose2& pose, const PoseBox& box, double margin_xy, double margin_theta)
@@ -71,15 +83,7 @@ LocalSolveOutcome localSolve(const MapRayCaster& map, const BoxOccupancy& occupa
   const int k = static_cast<int>(readings.size());
   outcome.best_consensus = -k;
   outcome.least_contradicted = k;
-  AdaptiveSearchOptions options;
-  options.cell_xy = settings.cell_xy;
-  options.cell_theta = settings.cell_theta;
-  options.min_count = settings.min_consensus;
-  options.range_tolerance = settings.range_tolerance;
-  options.max_boxes = settings.max_boxes;
-  options.threads = 1;
-  options.region = box;
-  const AdaptiveSearchResult found = adaptiveSearch(map, occupancy, readings, options);
+  const AdaptiveSearchResult found = adaptiveSearch(map, occupancy, readings, searchOptions(box, settings));
   outcome.truncated = found.truncated;
   for (const LeafBox& leaf : found.leaves)
   {

@@ -78,6 +78,11 @@ struct TrackerOptions
   double agreement_tolerance = 0.05;  ///< eps [m] (the node takes the localizer's)
   double range_tolerance = 0.02;      ///< tau [m] (the node takes the localizer's)
   int max_seeds = 3;                  ///< leaves refined per local solve
+  /// Each fix's covariance is multiplied by this before it is fused, in [1, 1000]. Batches that
+  /// slide by s of their k readings share k - s readings with the previous one, so their fixes
+  /// are not independent: a filter taking each as new evidence would count every reading k / s
+  /// times and grow overconfident (the node sets k / ~batch_stride).
+  double fix_covariance_scale = 1.0;
 };
 
 /// Every problem of @p options, as "NAME = VALUE is out of range; allowed: RANGE" (@p name maps

@@ -289,7 +289,12 @@ TrackState HypothesisTracker::state() const
   {
     return TrackState::Tracking;
   }
-  return failed_updates_ >= options_.lost_updates ? TrackState::Lost : TrackState::Ambiguous;
+  // A hypothesis coasting through misses without a conflict (readings hidden by people, a
+  // stretch the readings barely constrain) is not lost.
+  const bool coasting = std::any_of(hypotheses_.begin(), hypotheses_.end(), [&](const Hypothesis& h) {
+    return h.fixes > 0 && !h.conflicted && h.misses <= options_.tolerated_misses;
+  });
+  return failed_updates_ >= options_.lost_updates && !coasting ? TrackState::Lost : TrackState::Ambiguous;
 }
 
 }  // namespace core

@@ -70,7 +70,8 @@ struct TrackerOptions
   double publish_max_xy = 0.1;       ///< ... and 3 sigma of its position is at most this [m], > 0
   double publish_max_theta = 0.087;  ///< ... and 3 sigma of its heading at most this [rad], > 0
   int max_misses = 30;  ///< a hypothesis missing this many updates in a row is dropped, > tolerated_misses
-  /// Every hypothesis missed this many updates in a row and none is clearly supported: lost, >= 1
+  /// Every hypothesis missed this many updates in a row, none is clearly supported and none with
+  /// a fix coasts (a conflict, or more than tolerated_misses misses): lost, >= 1
   int lost_updates = 6;
   int max_hypotheses = 10;            ///< the least supported beyond this are dropped, >= 1
   double merge_distance = 0.1;        ///< hypotheses closer than this [m] ...
@@ -112,7 +113,7 @@ enum class TrackState
   Empty,      ///< no hypothesis
   Tracking,   ///< exactly one hypothesis is clearly supported
   Ambiguous,  ///< hypotheses, none clearly supported
-  Lost        ///< every hypothesis missed lost_updates updates in a row, none clearly supported
+  Lost        ///< every hypothesis missed lost_updates updates in a row, none clearly supported or coasting
 };
 const char* toString(TrackState state);
 

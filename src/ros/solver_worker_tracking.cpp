@@ -108,8 +108,12 @@ std::string SolverWorker::collectGlobalSearch()
   }
   handover_pending_ = true;
   // The candidates are poses of the base at the search's batch: as map -> odom transforms they
-  // hold now too (the tracker keeps hypotheses as map -> odom).
-  tracker_->seed(global.candidates, search.reference, 0.0);
+  // hold now too (the tracker keeps hypotheses as map -> odom). A search cut short proves nothing
+  // about the places it did not finish: a lone candidate of it could look unique when it is not.
+  if (!global.truncated)
+  {
+    tracker_->seed(global.candidates, search.reference, 0.0);
+  }
   {
     std::lock_guard<std::mutex> lock(state_.mutex);
     ++state_.tracking.global_searches;
@@ -121,7 +125,7 @@ std::string SolverWorker::collectGlobalSearch()
                                             (", the best explains " + std::to_string(global.candidates[0].inliers) +
                                              " of " + std::to_string(search.readings) + " readings")
                                                 .c_str(),
-                global.times.total, global.truncated ? " (cut short)" : "", tracker_->hypotheses().size());
+                global.times.total, global.truncated ? " (cut short: not seeded)" : "", tracker_->hypotheses().size());
   return text;
 }
 

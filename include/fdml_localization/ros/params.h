@@ -91,8 +91,9 @@ struct Params
   core::TrackerOptions tracker;
   int global_interval = 40;  ///< ~global_interval: updates without a clear hypothesis between global searches, [1, 1e6]
   /// ~global_deadline [s]: wall-time budget of each tracking global search (the adaptive engine,
-  /// whatever ~engine is), [0, 3600]; 0 = none
-  double global_deadline = 0.5;
+  /// whatever ~engine is; it runs beside the tracking), [0, 3600]; 0 = none. A search cut short
+  /// seeds nothing.
+  double global_deadline = 0.0;
   bool publish_initialpose =
       false;  ///< ~publish_initialpose: the first clear fix after a relocalization on initialpose
 };

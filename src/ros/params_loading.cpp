@@ -40,9 +40,9 @@ void readTrackingParams(ParamReader& r, Params* p)
     r.read(real.first, real.second);
   }
   const std::pair<const char*, int*> integers[] = {
-    { "tolerated_misses", &t.tolerated_misses }, { "max_misses", &t.max_misses },
-    { "lost_updates", &t.lost_updates },         { "max_hypotheses", &t.max_hypotheses },
-    { "tracking_max_seeds", &t.max_seeds },      { "global_interval", &p->global_interval },
+    { "tolerated_misses", &t.tolerated_misses },  { "max_misses", &t.max_misses },
+    { "lost_updates", &t.lost_updates },          { "max_hypotheses", &t.max_hypotheses },
+    { "tracking_max_seeds", &t.max_seeds },       { "global_interval", &p->global_interval },
     { "conflict_readings", &t.conflict_readings }
   };
   for (const auto& integer : integers)

@@ -250,8 +250,8 @@ std::unique_ptr<core::HypothesisTracker> SolverWorker::trackerFor(const std::sha
 
 void SolverWorker::applyMap(const nav_msgs::OccupancyGrid::ConstPtr& msg)
 {
-  waitForTables();          // the build in progress uses localizer_ (and cache_warned_)
-  global_search_.reset();   // waits for a global search in progress (it uses global_localizer_)
+  waitForTables();         // the build in progress uses localizer_ (and cache_warned_)
+  global_search_.reset();  // waits for a global search in progress (it uses global_localizer_)
   const std::string source = "topic " + map_topic_;
   const auto start = std::chrono::steady_clock::now();
   std::shared_ptr<const core::MapRayCaster> map;

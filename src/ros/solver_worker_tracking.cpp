@@ -94,8 +94,7 @@ void SolverWorker::startGlobalSearch(const Job& job)
 
 std::string SolverWorker::collectGlobalSearch()
 {
-  if (!global_search_ ||
-      global_search_->result.wait_for(std::chrono::seconds(0)) != std::future_status::ready)
+  if (!global_search_ || global_search_->result.wait_for(std::chrono::seconds(0)) != std::future_status::ready)
   {
     return std::string();
   }

@@ -112,8 +112,8 @@ private:
   NodeState& state_;
   ResultPublisher& publisher_;
   std::string map_topic_;
-  std::shared_ptr<const core::MapRayCaster> map_;     ///< worker thread only; null until a map
-  std::unique_ptr<core::Localizer> localizer_;        ///< worker thread only (~localize); null until a map
+  std::shared_ptr<const core::MapRayCaster> map_;  ///< worker thread only; null until a map
+  std::unique_ptr<core::Localizer> localizer_;     ///< worker thread only (~localize); null until a map
   /// The tracking global searches' localizer: the adaptive engine within ~global_deadline (no
   /// table to wait for); worker thread only, null until a map
   std::unique_ptr<core::Localizer> global_localizer_;
@@ -124,11 +124,11 @@ private:
   struct PendingSearch
   {
     std::future<core::Result> result;
-    core::Pose2 reference;        ///< the odometry pose of the base its readings refer to
-    std::uint64_t generation = 0; ///< NodeState::generation it was started in
+    core::Pose2 reference;         ///< the odometry pose of the base its readings refer to
+    std::uint64_t generation = 0;  ///< NodeState::generation it was started in
     std::size_t readings = 0;
   };
-  std::optional<PendingSearch> global_search_;  ///< worker thread only
+  std::optional<PendingSearch> global_search_;        ///< worker thread only
   std::unique_ptr<core::HypothesisTracker> tracker_;  ///< worker thread only; null until a map
   std::uint64_t generation_ = 0;                      ///< NodeState::generation of the last batch
   int updates_since_global_ = 0;                      ///< tracking updates since the last global search

@@ -278,7 +278,7 @@ SearchContext makeContext(const MapRayCaster& map, const std::vector<Reading>& r
   if (options.deadline > 0.0)
   {
     ctx.deadline = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                           std::chrono::duration<double>(options.deadline));
+                                                          std::chrono::duration<double>(options.deadline));
   }
   ctx.threads = options.threads > 0 ? options.threads : omp_get_max_threads();
   ctx.settings.agreement_tolerance = options.agreement_tolerance;

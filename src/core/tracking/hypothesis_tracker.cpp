@@ -66,12 +66,12 @@ PoseBox HypothesisTracker::boxOf(const Hypothesis& h, const Pose2& reference) co
 {
   const Pose2 p = compose(h.map_to_odom, reference);
   const TrackerOptions& o = options_;
-  const double xy = std::min(o.box_max_xy, std::max(positionSigma3(h.covariance),
-                                                     o.box_min_xy + 3.0 * (o.odom_alpha3 * h.travelled +
-                                                                           o.odom_alpha4 * h.turned)));
-  const double theta = std::min(o.box_max_theta, std::max(headingSigma3(h.covariance),
-                                                          o.box_min_theta + 3.0 * (o.odom_alpha1 * h.turned +
-                                                                                   o.odom_alpha2 * h.travelled)));
+  const double xy =
+      std::min(o.box_max_xy, std::max(positionSigma3(h.covariance),
+                                      o.box_min_xy + 3.0 * (o.odom_alpha3 * h.travelled + o.odom_alpha4 * h.turned)));
+  const double theta = std::min(
+      o.box_max_theta, std::max(headingSigma3(h.covariance),
+                                o.box_min_theta + 3.0 * (o.odom_alpha1 * h.turned + o.odom_alpha2 * h.travelled)));
   return PoseBox{ p.x - xy, p.x + xy, p.y - xy, p.y + xy, p.theta - theta, p.theta + theta };
 }
 
@@ -80,8 +80,7 @@ void HypothesisTracker::accumulateMotion(const Pose2& reference)
   if (have_reference_)
   {
     const Pose2 d = between(last_reference_, reference);
-    const OdometryNoise noise{ options_.odom_alpha1, options_.odom_alpha2, options_.odom_alpha3,
-                               options_.odom_alpha4 };
+    const OdometryNoise noise{ options_.odom_alpha1, options_.odom_alpha2, options_.odom_alpha3, options_.odom_alpha4 };
     for (Hypothesis& h : hypotheses_)
     {
       h.travelled += std::hypot(d.x, d.y);

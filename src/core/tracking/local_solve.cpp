@@ -92,8 +92,7 @@ LocalSolveOutcome localSolve(const MapRayCaster& map, const BoxOccupancy& occupa
   if (found.leaves.empty())
   {
     // No leaf may explain k' readings: say whether the prediction is contradicted or only hidden.
-    outcome.least_contradicted =
-        evaluatePose(map, box.centre(), readings, settings.agreement_tolerance).contradicted;
+    outcome.least_contradicted = evaluatePose(map, box.centre(), readings, settings.agreement_tolerance).contradicted;
     return outcome;
   }
   RefinementSettings refine;

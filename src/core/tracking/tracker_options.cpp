@@ -44,10 +44,9 @@ std::vector<std::string> validate(const TrackerOptions& o, const std::function<s
         "an integer in (tolerated_misses, 1000]");
   check(o.conflict_readings >= 1 && o.conflict_readings <= 1000, "conflict_readings", o.conflict_readings,
         "an integer in [1, 1000]");
-  check(in(o.publish_max_xy, 0.0, 100.0) && o.publish_max_xy > 0.0, "publish_max_xy", o.publish_max_xy,
-        "(0, 100] m");
-  check(in(o.publish_max_theta, 0.0, kPi) && o.publish_max_theta > 0.0, "publish_max_theta",
-        o.publish_max_theta, "(0, pi] rad");
+  check(in(o.publish_max_xy, 0.0, 100.0) && o.publish_max_xy > 0.0, "publish_max_xy", o.publish_max_xy, "(0, 100] m");
+  check(in(o.publish_max_theta, 0.0, kPi) && o.publish_max_theta > 0.0, "publish_max_theta", o.publish_max_theta,
+        "(0, pi] rad");
   check(o.lost_updates >= 1 && o.lost_updates <= 1000, "lost_updates", o.lost_updates, "an integer in [1, 1000]");
   check(o.max_hypotheses >= 1 && o.max_hypotheses <= 1000, "max_hypotheses", o.max_hypotheses,
         "an integer in [1, 1000]");

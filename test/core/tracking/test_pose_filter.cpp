@@ -14,14 +14,15 @@ TEST(PoseFilter, DrivingSpreadsTheHeadingIntoThePosition)
   // noise: the lateral position inherits 2 m x the heading's uncertainty, fully correlated.
   const Eigen::Matrix3d prior = Eigen::Vector3d(0.0, 0.0, 0.05 * 0.05).asDiagonal();
   const core::OdometryNoise none{ 0.0, 0.0, 0.0, 0.0 };
-  const Eigen::Matrix3d p = core::predictCovariance(prior, core::Pose2(1.0, 2.0, 0.0), core::Pose2(2.0, 0.0, 0.0), none);
+  const Eigen::Matrix3d p =
+      core::predictCovariance(prior, core::Pose2(1.0, 2.0, 0.0), core::Pose2(2.0, 0.0, 0.0), none);
   EXPECT_NEAR(p(1, 1), 4.0 * 0.05 * 0.05, 1e-12);
   EXPECT_NEAR(p(1, 2), 2.0 * 0.05 * 0.05, 1e-12);
   EXPECT_NEAR(p(0, 0), 0.0, 1e-12);
   // The odometry noise adds (alpha3 |trans|)^2 in x and y, (alpha2 |trans|)^2 in theta.
   const core::OdometryNoise noise{ 0.1, 0.2, 0.3, 0.4 };
-  const Eigen::Matrix3d q = core::predictCovariance(Eigen::Matrix3d::Zero(), core::Pose2(), core::Pose2(2.0, 0.0, 0.5),
-                                                    noise);
+  const Eigen::Matrix3d q =
+      core::predictCovariance(Eigen::Matrix3d::Zero(), core::Pose2(), core::Pose2(2.0, 0.0, 0.5), noise);
   EXPECT_NEAR(q(0, 0), std::pow(0.3 * 2.0 + 0.4 * 0.5, 2), 1e-12);
   EXPECT_NEAR(q(2, 2), std::pow(0.1 * 0.5 + 0.2 * 2.0, 2), 1e-12);
 }

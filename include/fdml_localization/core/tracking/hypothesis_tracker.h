@@ -58,8 +58,8 @@ struct TrackerOptions
   /// support <- decay support + net consensus / k per update; a miss adds the best consensus
   /// (below k') refined in its box, 0 for an empty box. In (0, 1).
   double support_decay = 0.95;
-  double min_support = 3.0;           ///< a clearly supported hypothesis has at least this support, > 0
-  double support_margin = 1.5;        ///< ... and this much more than any other, >= 0
+  double min_support = 3.0;     ///< a clearly supported hypothesis has at least this support, > 0
+  double support_margin = 1.5;  ///< ... and this much more than any other, >= 0
   /// ... and missed at most this many updates in a row (it coasts on odometry meanwhile, its
   /// covariance growing), none of them a conflict, >= 0
   int tolerated_misses = 20;
@@ -69,7 +69,7 @@ struct TrackerOptions
   int conflict_readings = 2;
   double publish_max_xy = 0.1;       ///< ... and 3 sigma of its position is at most this [m], > 0
   double publish_max_theta = 0.087;  ///< ... and 3 sigma of its heading at most this [rad], > 0
-  int max_misses = 30;  ///< a hypothesis missing this many updates in a row is dropped, > tolerated_misses
+  int max_misses = 30;               ///< a hypothesis missing this many updates in a row is dropped, > tolerated_misses
   /// Every hypothesis missed this many updates in a row, none is clearly supported and none with
   /// a fix coasts (a conflict, or more than tolerated_misses misses): lost, >= 1
   int lost_updates = 6;
@@ -94,17 +94,17 @@ std::vector<std::string> validate(const TrackerOptions& options,
 /// One pose hypothesis.
 struct Hypothesis
 {
-  std::uint64_t id = 0;    ///< unique in the tracker's life
-  Pose2 map_to_odom;       ///< the hypothesis [m, rad]
-  double travelled = 0.0;  ///< odometry distance since the last fix [m]
-  double turned = 0.0;     ///< odometry rotation since the last fix [rad]
-  double support = 0.0;    ///< decayed sum of net consensus / k
-  int misses = 0;          ///< updates in a row without a fix
-  bool conflicted = false; ///< the last update was a miss in conflict (TrackerOptions::conflict_readings)
+  std::uint64_t id = 0;     ///< unique in the tracker's life
+  Pose2 map_to_odom;        ///< the hypothesis [m, rad]
+  double travelled = 0.0;   ///< odometry distance since the last fix [m]
+  double turned = 0.0;      ///< odometry rotation since the last fix [rad]
+  double support = 0.0;     ///< decayed sum of net consensus / k
+  int misses = 0;           ///< updates in a row without a fix
+  bool conflicted = false;  ///< the last update was a miss in conflict (TrackerOptions::conflict_readings)
   /// Of the base's pose map_to_odom (+) the tracker's last reference (x, y, theta) [m^2, rad^2]
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  int fixes = 0;           ///< updates with a fix
-  Candidate last_fix;      ///< the last fix (pose of the base at its update's reference)
+  int fixes = 0;       ///< updates with a fix
+  Candidate last_fix;  ///< the last fix (pose of the base at its update's reference)
 };
 
 /// The tracker's state.

@@ -178,6 +178,8 @@ void validateTrackingParams(const Params& p, std::vector<std::string>* errors)
   }
   check(errors, p.global_interval >= 1 && p.global_interval <= 1000000, "global_interval", p.global_interval,
         "an integer in [1, 1000000]");
+  check(errors, std::isfinite(p.global_deadline) && p.global_deadline >= 0.0 && p.global_deadline <= 3600.0,
+        "global_deadline", p.global_deadline, "[0, 3600] s");
 }
 }  // namespace
 
@@ -297,6 +299,7 @@ std::string describe(const Params& p)
       << ", min_consensus_fraction: " << p.tracker.min_consensus_fraction << ", min_support: " << p.tracker.min_support
       << ", support_margin: " << p.tracker.support_margin << ", lost_updates: " << p.tracker.lost_updates
       << ", max_hypotheses: " << p.tracker.max_hypotheses << ", global_interval: " << p.global_interval
+      << ", global_deadline: " << p.global_deadline
       << ", publish_initialpose: " << (p.publish_initialpose ? "true" : "false");
   return out.str();
 }

@@ -32,21 +32,25 @@ void readTrackingParams(ParamReader& r, Params* p)
                                                     { "tracking_cell_xy", &t.cell_xy },
                                                     { "tracking_cell_theta", &t.cell_theta },
                                                     { "tracking_merge_distance", &t.merge_distance },
-                                                    { "tracking_merge_angle", &t.merge_angle } };
+                                                    { "tracking_merge_angle", &t.merge_angle },
+                                                    { "publish_max_xy", &t.publish_max_xy },
+                                                    { "publish_max_theta", &t.publish_max_theta } };
   for (const auto& real : reals)
   {
     r.read(real.first, real.second);
   }
   const std::pair<const char*, int*> integers[] = {
-    { "tolerated_misses", &t.tolerated_misses }, { "max_misses", &t.max_misses },
-    { "lost_updates", &t.lost_updates },         { "max_hypotheses", &t.max_hypotheses },
-    { "tracking_max_seeds", &t.max_seeds },      { "global_interval", &p->global_interval }
+    { "tolerated_misses", &t.tolerated_misses },  { "max_misses", &t.max_misses },
+    { "lost_updates", &t.lost_updates },          { "max_hypotheses", &t.max_hypotheses },
+    { "tracking_max_seeds", &t.max_seeds },       { "global_interval", &p->global_interval },
+    { "conflict_readings", &t.conflict_readings }
   };
   for (const auto& integer : integers)
   {
     r.read(integer.first, integer.second);
   }
   r.read("publish_initialpose", &p->publish_initialpose);
+  r.read("global_deadline", &p->global_deadline);
 }
 
 void readMapParams(ParamReader& r, Params* p)

@@ -8,6 +8,7 @@
 
 #include <ros/ros.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <utility>
@@ -26,6 +27,7 @@ SolverWorker::SolverWorker(const Params& params, NodeState& state, ResultPublish
     }
     const core::LocalizerOptions options = optionsFor(map);
     localizer_.reset(new core::Localizer(map.map, options));
+    global_localizer_ = globalLocalizerFor(map.map, options);
     tracker_ = trackerFor(map.map, options);
     publisher_.publishMapMarkers(*map_);
   }
@@ -36,6 +38,42 @@ SolverWorker::~SolverWorker()
   if (thread_.joinable())
   {
     thread_.join();
+  }
+  global_search_.reset();
+  waitForTables();
+}
+
+std::unique_ptr<core::Localizer> SolverWorker::globalLocalizerFor(const std::shared_ptr<const core::MapRayCaster>& map,
+                                                                  core::LocalizerOptions options) const
+{
+  options.engine = core::Engine::Adaptive;
+  options.deadline = params_.global_deadline;
+  return std::make_unique<core::Localizer>(map, options);
+}
+
+void SolverWorker::prepareInBackground()
+{
+  table_thread_ = std::thread([this] {
+    try
+    {
+      const auto start = std::chrono::steady_clock::now();
+      localizer_->prepare();
+      ROS_INFO("fdml_localizer: ~localize ready (%s engine, tables in %.2f s)", params_.engine.c_str(),
+               core::secondsSince(start));
+      warnCacheOnce(*localizer_);
+    }
+    catch (const std::exception& error)
+    {
+      ROS_ERROR("fdml_localizer: preparing the localizer failed: %s", error.what());
+    }
+  });
+}
+
+void SolverWorker::waitForTables()
+{
+  if (table_thread_.joinable())
+  {
+    table_thread_.join();
   }
 }
 
@@ -64,18 +102,8 @@ void SolverWorker::loop()
 {
   if (localizer_)
   {
-    try
-    {
-      const auto start = std::chrono::steady_clock::now();
-      localizer_->prepare();
-      ROS_INFO("fdml_localizer: localizer ready (%s engine, tables in %.2f s)", params_.engine.c_str(),
-               core::secondsSince(start));
-      warnCacheOnce(*localizer_);
-    }
-    catch (const std::exception& error)
-    {
-      ROS_ERROR("fdml_localizer: preparing the localizer failed: %s", error.what());
-    }
+    // Tracking starts at once (its global searches need no table); ~localize waits for these.
+    prepareInBackground();
   }
   {
     std::lock_guard<std::mutex> lock(state_.mutex);
@@ -140,6 +168,7 @@ Outcome SolverWorker::solve(const Job& job)
   core::Result result;
   try
   {
+    waitForTables();
     result = localizer_->localize(job.readings);
     outcome.success = !result.candidates.empty();
     outcome.message = describeOutcome(result, core::isUnambiguous(result));
@@ -213,15 +242,21 @@ std::unique_ptr<core::HypothesisTracker> SolverWorker::trackerFor(const std::sha
   core::TrackerOptions tracker = params_.tracker;
   tracker.agreement_tolerance = options.agreement_tolerance;
   tracker.range_tolerance = options.range_tolerance;
+  // Successive batches share k - stride readings: each fix counts stride / k of a new one.
+  tracker.fix_covariance_scale =
+      static_cast<double>(params_.measurements_per_batch) / std::max(1, params_.batch_stride);
   return std::make_unique<core::HypothesisTracker>(map, tracker);
 }
 
 void SolverWorker::applyMap(const nav_msgs::OccupancyGrid::ConstPtr& msg)
 {
+  waitForTables();         // the build in progress uses localizer_ (and cache_warned_)
+  global_search_.reset();  // waits for a global search in progress (it uses global_localizer_)
   const std::string source = "topic " + map_topic_;
   const auto start = std::chrono::steady_clock::now();
   std::shared_ptr<const core::MapRayCaster> map;
   std::unique_ptr<core::Localizer> localizer;
+  std::unique_ptr<core::Localizer> global;
   std::unique_ptr<core::HypothesisTracker> tracker;
   std::string error;
   try
@@ -231,6 +266,7 @@ void SolverWorker::applyMap(const nav_msgs::OccupancyGrid::ConstPtr& msg)
     const core::LocalizerOptions options = optionsFor(loaded);
     localizer.reset(new core::Localizer(loaded.map, options));
     localizer->prepare();
+    global = globalLocalizerFor(loaded.map, options);
     warnCacheOnce(*localizer);
     tracker = trackerFor(loaded.map, options);
     map = loaded.map;
@@ -254,6 +290,7 @@ void SolverWorker::applyMap(const nav_msgs::OccupancyGrid::ConstPtr& msg)
   // Between two solves: the next one uses the new map.
   map_ = map;
   localizer_ = std::move(localizer);
+  global_localizer_ = std::move(global);
   if (tracker_)
   {
     // A map of the same frame (a SLAM map growing): the hypotheses carry over.

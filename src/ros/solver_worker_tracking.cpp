@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <future>
 
 namespace fdml_localization
 {
@@ -78,24 +79,52 @@ bool SolverWorker::needsGlobalSearch(bool relocalizing) const
   return false;
 }
 
-std::string SolverWorker::globalSearch(const Job& job)
+void SolverWorker::startGlobalSearch(const Job& job)
 {
-  const core::Result global = localizer_->localize(job.readings);
   updates_since_global_ = 0;
+  core::Localizer* localizer = global_localizer_.get();
+  const std::vector<core::Reading> readings = job.readings;
+  global_search_.emplace();
+  global_search_->result =
+      std::async(std::launch::async, [localizer, readings] { return localizer->localize(readings); });
+  global_search_->reference = job.batch.base_first;
+  global_search_->generation = generation_;
+  global_search_->readings = job.readings.size();
+}
+
+std::string SolverWorker::collectGlobalSearch()
+{
+  if (!global_search_ || global_search_->result.wait_for(std::chrono::seconds(0)) != std::future_status::ready)
+  {
+    return std::string();
+  }
+  PendingSearch search = std::move(*global_search_);
+  global_search_.reset();
+  const core::Result global = search.result.get();
+  if (search.generation != generation_)
+  {
+    return std::string();
+  }
   handover_pending_ = true;
-  tracker_->seed(global.candidates, job.batch.base_first, 0.0);
+  // The candidates are poses of the base at the search's batch: as map -> odom transforms they
+  // hold now too (the tracker keeps hypotheses as map -> odom). A search cut short proves nothing
+  // about the places it did not finish: a lone candidate of it could look unique when it is not.
+  if (!global.truncated)
+  {
+    tracker_->seed(global.candidates, search.reference, 0.0);
+  }
   {
     std::lock_guard<std::mutex> lock(state_.mutex);
     ++state_.tracking.global_searches;
   }
   char text[200];
-  std::snprintf(text, sizeof(text), "global search: %zu candidate(s)%s in %.3f s; %zu hypotheses",
+  std::snprintf(text, sizeof(text), "global search: %zu candidate(s)%s in %.3f s%s; %zu hypotheses",
                 global.candidates.size(),
                 global.candidates.empty() ? "" :
                                             (", the best explains " + std::to_string(global.candidates[0].inliers) +
-                                             " of " + std::to_string(job.readings.size()) + " readings")
+                                             " of " + std::to_string(search.readings) + " readings")
                                                 .c_str(),
-                global.times.total, tracker_->hypotheses().size());
+                global.times.total, global.truncated ? " (cut short: not seeded)" : "", tracker_->hypotheses().size());
   return text;
 }
 
@@ -142,6 +171,7 @@ core::Result SolverWorker::trackedResult(const Job& job) const
     core::Candidate c = h.last_fix;
     c.pose = core::compose(h.map_to_odom, job.batch.base_first);
     c.support = h.support;
+    c.covariance = h.covariance;
     c.inlier_mask.resize(job.readings.size(), false);
     result.candidates.push_back(c);
   }
@@ -156,16 +186,17 @@ std::string SolverWorker::stepTracker(const Directive& directive, const Job& job
     {
       return applyHint(*directive.hint, job);
     }
-    if (needsGlobalSearch(directive.relocalizing))
+    const std::string event = collectGlobalSearch();
+    if (!global_search_ && needsGlobalSearch(directive.relocalizing))
     {
-      return globalSearch(job);
+      startGlobalSearch(job);
     }
     if (!tracker_->hypotheses().empty())
     {
       tracker_->update(job.readings, job.batch.base_first);
       ++updates_since_global_;
     }
-    return std::string();
+    return event;
   }
   catch (const std::exception& error)
   {

@@ -23,7 +23,8 @@
  * Tracking (docs/localizer_node.md#tracking): the worker updates a core::HypothesisTracker with
  * every batch; global searches seed it at start (continuous mode), on ~relocalize,
  * global_localization and initialpose hints, on a detected kidnap (continuous mode) and after
- * ~global_interval updates without a clearly supported hypothesis. ~relocalize answers once one
+ * ~global_interval updates without a clearly supported hypothesis (beside the tracking, in a
+ * thread of their own: they never hold it). ~relocalize answers once one
  * hypothesis is clearly supported. ~pose and map -> odom follow every update while one is, and
  * are withdrawn otherwise; ~status reports the state.
  */

@@ -84,11 +84,16 @@ struct Params
   /// Parameters set with the wrong type (ParamReader messages; validate() reports them first).
   std::vector<std::string> type_errors;
   // Tracking (docs/localizer_node.md#tracking): ~odom_alpha1..4, ~min_consensus_fraction,
-  // ~support_decay, ~min_support, ~support_margin, ~tolerated_misses, ~max_misses,
-  // ~lost_updates, ~max_hypotheses and the ~tracking_* box options map onto core::TrackerOptions,
+  // ~support_decay, ~min_support, ~support_margin, ~tolerated_misses, ~conflict_readings,
+  // ~publish_max_xy, ~publish_max_theta, ~max_misses, ~lost_updates, ~max_hypotheses and the
+  // ~tracking_* box options map onto core::TrackerOptions,
   // validated by core::validate() (its tolerances are the localizer's).
   core::TrackerOptions tracker;
   int global_interval = 40;  ///< ~global_interval: updates without a clear hypothesis between global searches, [1, 1e6]
+  /// ~global_deadline [s]: wall-time budget of each tracking global search (the adaptive engine,
+  /// whatever ~engine is; it runs beside the tracking), [0, 3600]; 0 = none. A search cut short
+  /// seeds nothing.
+  double global_deadline = 0.0;
   bool publish_initialpose =
       false;  ///< ~publish_initialpose: the first clear fix after a relocalization on initialpose
 };

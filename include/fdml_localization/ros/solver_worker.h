@@ -17,6 +17,7 @@
 
 #include <nav_msgs/OccupancyGrid.h>
 
+#include <future>
 #include <memory>
 #include <optional>
 #include <string>
@@ -59,6 +60,13 @@ private:
   static std::string describeOutcome(const core::Result& result, bool unambiguous);
   /// The core options for @p map: the parameters, with grid tolerances for a converted grid.
   core::LocalizerOptions optionsFor(const LoadedMap& map) const;
+  /// The adaptive engine within ~global_deadline, otherwise @p options.
+  std::unique_ptr<core::Localizer> globalLocalizerFor(const std::shared_ptr<const core::MapRayCaster>& map,
+                                                      core::LocalizerOptions options) const;
+  /// Builds localizer_'s tables beside the worker (logs when ready).
+  void prepareInBackground();
+  /// Joins the table build started by prepareInBackground().
+  void waitForTables();
   /// The tracker for @p map, with the localizer's tolerances.
   std::unique_ptr<core::HypothesisTracker> trackerFor(const std::shared_ptr<const core::MapRayCaster>& map,
                                                       const core::LocalizerOptions& options) const;
@@ -86,8 +94,11 @@ private:
   void publishTracking(const Job& job, const core::Result& result, const Outcome& outcome);
   /// True when this batch needs a global search (docs/localizer_node.md#tracking).
   bool needsGlobalSearch(bool relocalizing) const;
-  /// Runs the global search on @p job and seeds the tracker with its candidates.
-  std::string globalSearch(const Job& job);
+  /// Starts a global search on @p job's readings beside the tracking (global_search_).
+  void startGlobalSearch(const Job& job);
+  /// Seeds the tracker with the candidates of a finished global search; the event (empty: none
+  /// finished, or it was for hypotheses dropped since by a relocalization request).
+  std::string collectGlobalSearch();
   /// Applies a pose hint to the tracker; the outcome as text.
   std::string applyHint(const PoseHint& hint, const Job& job);
   /// The hypotheses as a core::Result (poses at the batch's first reading), best first.
@@ -101,8 +112,23 @@ private:
   NodeState& state_;
   ResultPublisher& publisher_;
   std::string map_topic_;
-  std::shared_ptr<const core::MapRayCaster> map_;     ///< worker thread only; null until a map
-  std::unique_ptr<core::Localizer> localizer_;        ///< worker thread only; null until a map
+  std::shared_ptr<const core::MapRayCaster> map_;  ///< worker thread only; null until a map
+  std::unique_ptr<core::Localizer> localizer_;     ///< worker thread only (~localize); null until a map
+  /// The tracking global searches' localizer: the adaptive engine within ~global_deadline (no
+  /// table to wait for); worker thread only, null until a map
+  std::unique_ptr<core::Localizer> global_localizer_;
+  /// Prepares localizer_ (the voxel engine's table) beside the tracking at start; joined before
+  /// localizer_ is used or replaced (waitForTables())
+  std::thread table_thread_;
+  /// A global search under way beside the tracking (global_localizer_ is used by it alone).
+  struct PendingSearch
+  {
+    std::future<core::Result> result;
+    core::Pose2 reference;         ///< the odometry pose of the base its readings refer to
+    std::uint64_t generation = 0;  ///< NodeState::generation it was started in
+    std::size_t readings = 0;
+  };
+  std::optional<PendingSearch> global_search_;        ///< worker thread only
   std::unique_ptr<core::HypothesisTracker> tracker_;  ///< worker thread only; null until a map
   std::uint64_t generation_ = 0;                      ///< NodeState::generation of the last batch
   int updates_since_global_ = 0;                      ///< tracking updates since the last global search
@@ -110,7 +136,7 @@ private:
   bool published_empty_ = false;                      ///< the last ~result published had no hypothesis
   bool was_tracking_ = false;                         ///< the last batch had a clearly supported hypothesis
   std::thread thread_;
-  bool cache_warned_ = false;  ///< worker thread only
+  bool cache_warned_ = false;  ///< worker thread, or the table build while it runs
 };
 
 }  // namespace fdml_localization

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 #include <cmath>
 #include <iterator>
 #include <numeric>
@@ -31,6 +32,14 @@ struct SearchContext
   RefinementSettings settings;
   double loose_gate = 0.0;  ///< agreement band of the rough count at a seed's start [m]
   int threads = 1;
+  /// LocalizerOptions::deadline as a time point (none when the deadline is 0): seeds not yet
+  /// refined by then are left unrefined.
+  std::optional<std::chrono::steady_clock::time_point> deadline;
+
+  bool outOfTime() const
+  {
+    return deadline && std::chrono::steady_clock::now() > *deadline;
+  }
 };
 
 double medianFiniteRange(const std::vector<Reading>& readings)
@@ -123,7 +132,7 @@ public:
 #pragma omp parallel for schedule(dynamic, 1) num_threads(ctx_.threads) if (n >= 4)
     for (long c = 0; c < n; ++c)
     {
-      if (!refined_[c] && seeds_[c].promised >= level && rough_[c] >= level - 2)
+      if (!refined_[c] && seeds_[c].promised >= level && rough_[c] >= level - 2 && !ctx_.outOfTime())
       {
         refined_[c] = 1;
         keepBetter(c, refineSeed(ctx_.map, seeds_[c].start, ctx_.readings, seeds_[c].hypothesis, with));
@@ -265,7 +274,12 @@ private:
 SearchContext makeContext(const MapRayCaster& map, const std::vector<Reading>& readings,
                           const LocalizerOptions& options, const SeedScale& scale)
 {
-  SearchContext ctx{ map, readings, scale, RefinementSettings(), 0.0, 1 };
+  SearchContext ctx{ map, readings, scale, RefinementSettings(), 0.0, 1, std::nullopt };
+  if (options.deadline > 0.0)
+  {
+    ctx.deadline = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                          std::chrono::duration<double>(options.deadline));
+  }
   ctx.threads = options.threads > 0 ? options.threads : omp_get_max_threads();
   ctx.settings.agreement_tolerance = options.agreement_tolerance;
   ctx.settings.robust_scale = seedGate(readings, options, scale) / 3.0;
@@ -321,7 +335,8 @@ SeedSearchOutcome robustSearch(SeedSource& source, const MapRayCaster& map, cons
   SeedPool pool(ctx);
   int used_level = lowest;
   bool reached = false;
-  for (int level = k; level >= lowest && !reached && !source.exhausted(); --level)
+  bool out_of_time = false;
+  for (int level = k; level >= lowest && !reached && !out_of_time && !source.exhausted(); --level)
   {
     std::vector<SearchSeed> seeds = source.seedsAt(level);
     auto stage = std::chrono::steady_clock::now();
@@ -343,6 +358,12 @@ SeedSearchOutcome robustSearch(SeedSource& source, const MapRayCaster& map, cons
       // (which promise fewer) cannot enter the ranked list.
       reached = static_cast<int>(pool.distinctReaching(level, options)) >= options.max_candidates;
     }
+    // The deadline (LocalizerOptions) stops the descent: the candidates found so far are ranked.
+    out_of_time = !reached && ctx.outOfTime();
+  }
+  if (out_of_time)
+  {
+    return pool.ranked(automatic ? std::max(lowest, pool.bestNet()) : options.min_inliers, options);
   }
   const auto stage = std::chrono::steady_clock::now();
   const int level = secondChances(pool, automatic, reached && pool.bestNet() >= used_level, used_level, lowest, k);

@@ -2,8 +2,6 @@
 
 #include "fdml_localization/core/localization/ranking.h"
 
-#include <Eigen/LU>
-
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -18,32 +16,6 @@ namespace
 bool samePlace(const Pose2& a, const Pose2& b, double distance, double angle)
 {
   return (a.position() - b.position()).norm() <= distance && std::abs(angleDiff(a.theta, b.theta)) <= angle;
-}
-
-/**
- * The fix fused with the prediction (one Kalman step): the prediction's covariance is the box's
- * (half-widths as 3 sigma), the fix's the polish's. A direction the readings leave loose (a
- * corridor's axis) keeps the prediction; a spoiled batch moves the pose less than its fix.
- */
-Pose2 fuse(const Pose2& predicted, const PoseBox& box, const Candidate& fix)
-{
-  const Eigen::Vector3d box_sigma(0.5 * (box.x1 - box.x0) / 3.0, 0.5 * (box.y1 - box.y0) / 3.0,
-                                  0.5 * (box.t1 - box.t0) / 3.0);
-  const Eigen::Matrix3d prior = box_sigma.cwiseProduct(box_sigma).asDiagonal();
-  const Eigen::Matrix3d& measured = fix.covariance;
-  if (!measured.allFinite() || measured.diagonal().minCoeff() <= 0.0)
-  {
-    return fix.pose;
-  }
-  const Eigen::Matrix3d sum = prior + measured;
-  if (std::abs(sum.determinant()) < 1e-30)
-  {
-    return fix.pose;
-  }
-  const Eigen::Vector3d innovation(fix.pose.x - predicted.x, fix.pose.y - predicted.y,
-                                   angleDiff(fix.pose.theta, predicted.theta));
-  const Eigen::Vector3d step = prior * sum.inverse() * innovation;
-  return Pose2(predicted.x + step.x(), predicted.y + step.y(), wrapAngle(predicted.theta + step.z()));
 }
 
 std::string joined(const std::vector<std::string>& errors)
@@ -95,9 +67,11 @@ PoseBox HypothesisTracker::boxOf(const Hypothesis& h, const Pose2& reference) co
   const Pose2 p = compose(h.map_to_odom, reference);
   const TrackerOptions& o = options_;
   const double xy =
-      std::min(o.box_max_xy, o.box_min_xy + 3.0 * (o.odom_alpha3 * h.travelled + o.odom_alpha4 * h.turned));
-  const double theta =
-      std::min(o.box_max_theta, o.box_min_theta + 3.0 * (o.odom_alpha1 * h.turned + o.odom_alpha2 * h.travelled));
+      std::min(o.box_max_xy, std::max(positionSigma3(h.covariance),
+                                      o.box_min_xy + 3.0 * (o.odom_alpha3 * h.travelled + o.odom_alpha4 * h.turned)));
+  const double theta = std::min(
+      o.box_max_theta, std::max(headingSigma3(h.covariance),
+                                o.box_min_theta + 3.0 * (o.odom_alpha1 * h.turned + o.odom_alpha2 * h.travelled)));
   return PoseBox{ p.x - xy, p.x + xy, p.y - xy, p.y + xy, p.theta - theta, p.theta + theta };
 }
 
@@ -106,10 +80,12 @@ void HypothesisTracker::accumulateMotion(const Pose2& reference)
   if (have_reference_)
   {
     const Pose2 d = between(last_reference_, reference);
+    const OdometryNoise noise{ options_.odom_alpha1, options_.odom_alpha2, options_.odom_alpha3, options_.odom_alpha4 };
     for (Hypothesis& h : hypotheses_)
     {
       h.travelled += std::hypot(d.x, d.y);
       h.turned += std::abs(d.theta);
+      h.covariance = predictCovariance(h.covariance, compose(h.map_to_odom, last_reference_), d, noise);
     }
   }
   last_reference_ = reference;
@@ -138,6 +114,7 @@ void HypothesisTracker::seed(const std::vector<Candidate>& candidates, const Pos
     h.map_to_odom = compose(c.pose, inverse(reference));
     h.support = support;
     h.last_fix = c;
+    h.covariance = initialCovariance(c);
     hypotheses_.push_back(std::move(h));
   }
   if (!candidates.empty())
@@ -145,6 +122,15 @@ void HypothesisTracker::seed(const std::vector<Candidate>& candidates, const Pos
     failed_updates_ = 0;
   }
   prune();
+}
+
+Eigen::Matrix3d HypothesisTracker::initialCovariance(const Candidate& candidate) const
+{
+  // At least the smallest search box (as 3 sigma): a global search's polish may be overconfident.
+  const Eigen::Vector3d floor(options_.box_min_xy / 3.0, options_.box_min_xy / 3.0, options_.box_min_theta / 3.0);
+  const Eigen::Matrix3d least = floor.cwiseProduct(floor).asDiagonal();
+  const Eigen::Matrix3d& polished = candidate.covariance;
+  return polished.allFinite() && polished.diagonal().minCoeff() > 0.0 ? Eigen::Matrix3d(polished + least) : least;
 }
 
 HintOutcome HypothesisTracker::seedFromHint(const PoseBox& box, const std::vector<Reading>& readings,
@@ -183,45 +169,57 @@ UpdateReport HypothesisTracker::update(const std::vector<Reading>& readings, con
   accumulateMotion(reference);
   for (Hypothesis& h : hypotheses_)
   {
-    const PoseBox box = boxOf(h, reference);
-    const LocalSolveOutcome found = localSolve(*map_, occupancy_, readings, box, settings);
-    report.best_possible = std::max(report.best_possible, found.best_possible);
-    report.truncated = report.truncated || found.truncated;
-    if (found.fixes.empty())
-    {
-      // A miss earns what the best pose refined in the box explains (below k'; 0 when the
-      // search pruned the whole box): a solver's near miss costs less than an empty box.
-      ++h.misses;
-      ++report.missed;
-      h.support = options_.support_decay * h.support + std::max(0, found.best_consensus) / static_cast<double>(k);
-      continue;
-    }
-    // Among the fixes tied with the best on net consensus, the one nearest the prediction carries
-    // the hypothesis (the box is its uncertainty: new places come from global solves only).
-    const Pose2 predicted = box.centre();
-    const int best = netConsensus(found.fixes.front());
-    std::size_t chosen = 0;
-    for (std::size_t i = 1; i < found.fixes.size() && netConsensus(found.fixes[i]) == best; ++i)
-    {
-      if ((found.fixes[i].pose.position() - predicted.position()).norm() <
-          (found.fixes[chosen].pose.position() - predicted.position()).norm())
-      {
-        chosen = i;
-      }
-    }
-    const Candidate& fix = found.fixes[chosen];
-    h.map_to_odom = compose(fuse(predicted, box, fix), inverse(reference));
-    h.travelled = 0.0;
-    h.turned = 0.0;
-    h.misses = 0;
-    ++h.fixes;
-    h.support = options_.support_decay * h.support + static_cast<double>(netConsensus(fix)) / k;
-    h.last_fix = fix;
-    ++report.fixed;
+    const bool fixed = updateOne(h, readings, reference, settings, report);
+    ++(fixed ? report.fixed : report.missed);
   }
   failed_updates_ = report.fixed > 0 ? 0 : failed_updates_ + 1;
   report.dropped = prune();
   return report;
+}
+
+bool HypothesisTracker::updateOne(Hypothesis& h, const std::vector<Reading>& readings, const Pose2& reference,
+                                  const LocalSolveSettings& settings, UpdateReport& report)
+{
+  const double k = static_cast<double>(readings.size());
+  const PoseBox box = boxOf(h, reference);
+  const LocalSolveOutcome found = localSolve(*map_, occupancy_, readings, box, settings);
+  report.best_possible = std::max(report.best_possible, found.best_possible);
+  report.truncated = report.truncated || found.truncated;
+  if (found.fixes.empty())
+  {
+    // A miss earns what the best pose refined in the box explains (below k'; 0 when the search
+    // pruned the whole box): a solver's near miss costs less than an empty box. Readings only
+    // hidden (by people) let the hypothesis coast on odometry; contradicted ones do not.
+    ++h.misses;
+    h.conflicted = found.least_contradicted >= options_.conflict_readings;
+    h.support = options_.support_decay * h.support + std::max(0, found.best_consensus) / k;
+    return false;
+  }
+  // Among the fixes tied with the best on net consensus, the one nearest the prediction carries
+  // the hypothesis (the box is its uncertainty: new places come from global solves only).
+  const Pose2 predicted = compose(h.map_to_odom, reference);
+  const int best = netConsensus(found.fixes.front());
+  std::size_t chosen = 0;
+  for (std::size_t i = 1; i < found.fixes.size() && netConsensus(found.fixes[i]) == best; ++i)
+  {
+    if ((found.fixes[i].pose.position() - predicted.position()).norm() <
+        (found.fixes[chosen].pose.position() - predicted.position()).norm())
+    {
+      chosen = i;
+    }
+  }
+  const Candidate& fix = found.fixes[chosen];
+  const FusedPose fused = fusePose(predicted, h.covariance, fix.pose, options_.fix_covariance_scale * fix.covariance);
+  h.map_to_odom = compose(fused.pose, inverse(reference));
+  h.covariance = fused.covariance;
+  h.travelled = 0.0;
+  h.turned = 0.0;
+  h.misses = 0;
+  h.conflicted = false;
+  ++h.fixes;
+  h.support = options_.support_decay * h.support + static_cast<double>(netConsensus(fix)) / k;
+  h.last_fix = fix;
+  return true;
 }
 
 int HypothesisTracker::prune()
@@ -273,8 +271,10 @@ const Hypothesis* HypothesisTracker::clearlySupported() const
   }
   const Hypothesis& best = hypotheses_.front();
   const double second = hypotheses_.size() > 1 ? hypotheses_[1].support : 0.0;
-  const bool clear = best.misses <= options_.tolerated_misses && best.support >= options_.min_support &&
-                     best.support - second >= options_.support_margin;
+  const bool clear = best.misses <= options_.tolerated_misses && !best.conflicted &&
+                     best.support >= options_.min_support && best.support - second >= options_.support_margin &&
+                     positionSigma3(best.covariance) <= options_.publish_max_xy &&
+                     headingSigma3(best.covariance) <= options_.publish_max_theta;
   return clear ? &best : nullptr;
 }
 
@@ -284,11 +284,16 @@ TrackState HypothesisTracker::state() const
   {
     return TrackState::Empty;
   }
-  if (failed_updates_ >= options_.lost_updates)
+  if (clearlySupported())
   {
-    return TrackState::Lost;
+    return TrackState::Tracking;
   }
-  return clearlySupported() ? TrackState::Tracking : TrackState::Ambiguous;
+  // A hypothesis coasting through misses without a conflict (readings hidden by people, a
+  // stretch the readings barely constrain) is not lost.
+  const bool coasting = std::any_of(hypotheses_.begin(), hypotheses_.end(), [&](const Hypothesis& h) {
+    return h.fixes > 0 && !h.conflicted && h.misses <= options_.tolerated_misses;
+  });
+  return failed_updates_ >= options_.lost_updates && !coasting ? TrackState::Lost : TrackState::Ambiguous;
 }
 
 }  // namespace core

@@ -53,6 +53,18 @@ std::vector<std::pair<Pose2, std::vector<bool>>> startsOf(std::vector<LeafBox> l
   }
   return starts;
 }
+AdaptiveSearchOptions searchOptions(const PoseBox& box, const LocalSolveSettings& settings)
+{
+  AdaptiveSearchOptions options;
+  options.cell_xy = settings.cell_xy;
+  options.cell_theta = settings.cell_theta;
+  options.min_count = settings.min_consensus;
+  options.range_tolerance = settings.range_tolerance;
+  options.max_boxes = settings.max_boxes;
+  options.threads = 1;
+  options.region = box;
+  return options;
+}
 }  // namespace
 
 bool insideBox(const Pose2& pose, const PoseBox& box, double margin_xy, double margin_theta)
@@ -70,15 +82,8 @@ LocalSolveOutcome localSolve(const MapRayCaster& map, const BoxOccupancy& occupa
   LocalSolveOutcome outcome;
   const int k = static_cast<int>(readings.size());
   outcome.best_consensus = -k;
-  AdaptiveSearchOptions options;
-  options.cell_xy = settings.cell_xy;
-  options.cell_theta = settings.cell_theta;
-  options.min_count = settings.min_consensus;
-  options.range_tolerance = settings.range_tolerance;
-  options.max_boxes = settings.max_boxes;
-  options.threads = 1;
-  options.region = box;
-  const AdaptiveSearchResult found = adaptiveSearch(map, occupancy, readings, options);
+  outcome.least_contradicted = k;
+  const AdaptiveSearchResult found = adaptiveSearch(map, occupancy, readings, searchOptions(box, settings));
   outcome.truncated = found.truncated;
   for (const LeafBox& leaf : found.leaves)
   {
@@ -86,6 +91,8 @@ LocalSolveOutcome localSolve(const MapRayCaster& map, const BoxOccupancy& occupa
   }
   if (found.leaves.empty())
   {
+    // No leaf may explain k' readings: say whether the prediction is contradicted or only hidden.
+    outcome.least_contradicted = evaluatePose(map, box.centre(), readings, settings.agreement_tolerance).contradicted;
     return outcome;
   }
   RefinementSettings refine;
@@ -99,6 +106,7 @@ LocalSolveOutcome localSolve(const MapRayCaster& map, const BoxOccupancy& occupa
   {
     Candidate c = refineSeed(map, start.first, readings, start.second, refine);
     outcome.best_consensus = std::max(outcome.best_consensus, netConsensus(c));
+    outcome.least_contradicted = std::min(outcome.least_contradicted, c.contradicted);
     if (netConsensus(c) >= settings.min_consensus && insideBox(c.pose, box, settings.cell_xy, settings.cell_theta))
     {
       fixes.push_back(std::move(c));

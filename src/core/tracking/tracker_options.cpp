@@ -40,7 +40,13 @@ std::vector<std::string> validate(const TrackerOptions& o, const std::function<s
   check(in(o.support_margin, 0.0, 1e6), "support_margin", o.support_margin, "[0, 1e6]");
   check(o.tolerated_misses >= 0 && o.tolerated_misses <= 1000, "tolerated_misses", o.tolerated_misses,
         "an integer in [0, 1000]");
-  check(o.max_misses >= 1 && o.max_misses <= 1000, "max_misses", o.max_misses, "an integer in [1, 1000]");
+  check(o.max_misses > o.tolerated_misses && o.max_misses <= 1000, "max_misses", o.max_misses,
+        "an integer in (tolerated_misses, 1000]");
+  check(o.conflict_readings >= 1 && o.conflict_readings <= 1000, "conflict_readings", o.conflict_readings,
+        "an integer in [1, 1000]");
+  check(in(o.publish_max_xy, 0.0, 100.0) && o.publish_max_xy > 0.0, "publish_max_xy", o.publish_max_xy, "(0, 100] m");
+  check(in(o.publish_max_theta, 0.0, kPi) && o.publish_max_theta > 0.0, "publish_max_theta", o.publish_max_theta,
+        "(0, pi] rad");
   check(o.lost_updates >= 1 && o.lost_updates <= 1000, "lost_updates", o.lost_updates, "an integer in [1, 1000]");
   check(o.max_hypotheses >= 1 && o.max_hypotheses <= 1000, "max_hypotheses", o.max_hypotheses,
         "an integer in [1, 1000]");
@@ -49,6 +55,7 @@ std::vector<std::string> validate(const TrackerOptions& o, const std::function<s
   check(in(o.agreement_tolerance, 0.0, 1e6) && o.agreement_tolerance > 0.0, "agreement_tolerance",
         o.agreement_tolerance, "(0, 1e6] m");
   check(in(o.range_tolerance, 0.0, 10.0), "range_tolerance", o.range_tolerance, "[0, 10] m");
+  check(in(o.fix_covariance_scale, 1.0, 1000.0), "fix_covariance_scale", o.fix_covariance_scale, "[1, 1000]");
   check(o.max_seeds >= 0 && o.max_seeds <= 100, "max_seeds", o.max_seeds, "an integer in [0, 100]");
   return errors;
 }

@@ -11,7 +11,9 @@
  *
  * Poses: the readings of an update are relative to the base at the odometry pose `reference`
  * (the node's batches: the base at the first reading); a hypothesis's pose of the base at any
- * odometry pose o is map_to_odom (+) o.
+ * odometry pose o is map_to_odom (+) o. Each hypothesis also carries the covariance of that pose
+ * (pose_filter.h: odometry steps spread it, fixes shrink it); it is published only while that
+ * covariance is within the publishing margins (publish_max_xy, publish_max_theta).
  */
 #pragma once
 
@@ -19,6 +21,7 @@
 #include "fdml_localization/core/localization/localizer.h"
 #include "fdml_localization/core/localization/voxel/box_occupancy.h"
 #include "fdml_localization/core/tracking/local_solve.h"
+#include "fdml_localization/core/tracking/pose_filter.h"
 
 #include <Eigen/Core>
 
@@ -38,9 +41,10 @@ struct TrackerOptions
   /// Net consensus a pose needs to count as a fix, as a fraction of k (k' = ceil(fraction k),
   /// at least 3), in (0, 1].
   double min_consensus_fraction = 0.6;
-  // Growth of the uncertainty box with odometry, as AMCL's odom_alpha1..4 (>= 0): the box's
-  // half-widths are box_min + 3 sigma, sigma_theta = alpha1 |rot| + alpha2 |trans|,
-  // sigma_xy = alpha3 |trans| + alpha4 |rot|, summed over the motion since the last fix.
+  // Odometry noise, as AMCL's odom_alpha1..4 (>= 0): sigma_theta = alpha1 |rot| + alpha2 |trans|,
+  // sigma_xy = alpha3 |trans| + alpha4 |rot|. Each odometry step adds these to the hypothesis's
+  // covariance (pose_filter.h); the search box's half-widths are the larger of 3 standard
+  // deviations of that covariance and box_min + 3 sigma summed over the motion since the last fix.
   double odom_alpha1 = 0.2;     ///< rotation noise from rotation [rad/rad]
   double odom_alpha2 = 0.2;     ///< rotation noise from translation [rad/m]
   double odom_alpha3 = 0.2;     ///< translation noise from translation [m/m]
@@ -54,17 +58,32 @@ struct TrackerOptions
   /// support <- decay support + net consensus / k per update; a miss adds the best consensus
   /// (below k') refined in its box, 0 for an empty box. In (0, 1).
   double support_decay = 0.95;
-  double min_support = 3.0;           ///< a clearly supported hypothesis has at least this support, > 0
-  double support_margin = 1.5;        ///< ... and this much more than any other, >= 0
-  int tolerated_misses = 1;           ///< ... and missed at most this many updates in a row, >= 0
-  int max_misses = 10;                ///< a hypothesis missing this many updates in a row is dropped, >= 1
-  int lost_updates = 6;               ///< every hypothesis missed this many updates in a row: lost, >= 1
+  double min_support = 3.0;     ///< a clearly supported hypothesis has at least this support, > 0
+  double support_margin = 1.5;  ///< ... and this much more than any other, >= 0
+  /// ... and missed at most this many updates in a row (it coasts on odometry meanwhile, its
+  /// covariance growing), none of them a conflict, >= 0
+  int tolerated_misses = 20;
+  /// A miss in which at least this many readings contradict every refined pose of the box
+  /// (longer than the map allows: no unknown obstacle explains them) is a conflict: the
+  /// hypothesis is not published until its next fix. >= 1
+  int conflict_readings = 2;
+  double publish_max_xy = 0.1;       ///< ... and 3 sigma of its position is at most this [m], > 0
+  double publish_max_theta = 0.087;  ///< ... and 3 sigma of its heading at most this [rad], > 0
+  int max_misses = 30;               ///< a hypothesis missing this many updates in a row is dropped, > tolerated_misses
+  /// Every hypothesis missed this many updates in a row, none is clearly supported and none with
+  /// a fix coasts (a conflict, or more than tolerated_misses misses): lost, >= 1
+  int lost_updates = 6;
   int max_hypotheses = 10;            ///< the least supported beyond this are dropped, >= 1
   double merge_distance = 0.1;        ///< hypotheses closer than this [m] ...
   double merge_angle = 0.1;           ///< ... and this [rad] are merged (the better kept)
   double agreement_tolerance = 0.05;  ///< eps [m] (the node takes the localizer's)
   double range_tolerance = 0.02;      ///< tau [m] (the node takes the localizer's)
   int max_seeds = 3;                  ///< leaves refined per local solve
+  /// Each fix's covariance is multiplied by this before it is fused, in [1, 1000]. Batches that
+  /// slide by s of their k readings share k - s readings with the previous one, so their fixes
+  /// are not independent: a filter taking each as new evidence would count every reading k / s
+  /// times and grow overconfident (the node sets k / ~batch_stride).
+  double fix_covariance_scale = 1.0;
 };
 
 /// Every problem of @p options, as "NAME = VALUE is out of range; allowed: RANGE" (@p name maps
@@ -75,14 +94,17 @@ std::vector<std::string> validate(const TrackerOptions& options,
 /// One pose hypothesis.
 struct Hypothesis
 {
-  std::uint64_t id = 0;    ///< unique in the tracker's life
-  Pose2 map_to_odom;       ///< the hypothesis [m, rad]
-  double travelled = 0.0;  ///< odometry distance since the last fix [m]
-  double turned = 0.0;     ///< odometry rotation since the last fix [rad]
-  double support = 0.0;    ///< decayed sum of net consensus / k
-  int misses = 0;          ///< updates in a row without a fix
-  int fixes = 0;           ///< updates with a fix
-  Candidate last_fix;      ///< the last fix (pose of the base at its update's reference)
+  std::uint64_t id = 0;     ///< unique in the tracker's life
+  Pose2 map_to_odom;        ///< the hypothesis [m, rad]
+  double travelled = 0.0;   ///< odometry distance since the last fix [m]
+  double turned = 0.0;      ///< odometry rotation since the last fix [rad]
+  double support = 0.0;     ///< decayed sum of net consensus / k
+  int misses = 0;           ///< updates in a row without a fix
+  bool conflicted = false;  ///< the last update was a miss in conflict (TrackerOptions::conflict_readings)
+  /// Of the base's pose map_to_odom (+) the tracker's last reference (x, y, theta) [m^2, rad^2]
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  int fixes = 0;       ///< updates with a fix
+  Candidate last_fix;  ///< the last fix (pose of the base at its update's reference)
 };
 
 /// The tracker's state.
@@ -91,7 +113,7 @@ enum class TrackState
   Empty,      ///< no hypothesis
   Tracking,   ///< exactly one hypothesis is clearly supported
   Ambiguous,  ///< hypotheses, none clearly supported
-  Lost        ///< every hypothesis missed lost_updates updates in a row
+  Lost        ///< every hypothesis missed lost_updates updates in a row, none clearly supported or coasting
 };
 const char* toString(TrackState state);
 
@@ -151,7 +173,7 @@ public:
     return hypotheses_;
   }
   /// The clearly supported hypothesis (see TrackerOptions: min_support, support_margin,
-  /// tolerated_misses), or null.
+  /// tolerated_misses, conflict_readings, publish_max_xy, publish_max_theta), or null.
   const Hypothesis* clearlySupported() const;
   TrackState state() const;
   /// Updates in a row in which no hypothesis had a fix (0 after a fix).
@@ -172,6 +194,11 @@ private:
   LocalSolveSettings solveSettings(int k) const;
   /// Adds the odometry motion from the last reference to @p reference to every hypothesis.
   void accumulateMotion(const Pose2& reference);
+  /// Re-solves @p h in its box; true on a fix.
+  bool updateOne(Hypothesis& h, const std::vector<Reading>& readings, const Pose2& reference,
+                 const LocalSolveSettings& settings, UpdateReport& report);
+  /// The covariance a new hypothesis at @p candidate starts with.
+  Eigen::Matrix3d initialCovariance(const Candidate& candidate) const;
   /// Merges duplicates, drops hypotheses that missed too often, sorts, bounds the count.
   int prune();
 

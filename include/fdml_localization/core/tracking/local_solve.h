@@ -41,6 +41,9 @@ struct LocalSolveOutcome
   int best_possible = 0;
   /// The best net consensus reached by a refined pose in the box (-k when nothing was refined).
   int best_consensus = 0;
+  /// The fewest readings contradicted (longer than the map allows: no unknown obstacle explains
+  /// them) at a refined pose, or at the box's centre when nothing was refined.
+  int least_contradicted = 0;
   bool truncated = false;  ///< the box budget ran out
 };
 

@@ -17,6 +17,8 @@ fi
 export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1:abort_on_error=0:exitcode=86"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1:exitcode=87"
 export OMP_NUM_THREADS="${OMP_NUM_THREADS:-2}"
+# The ROS unit tests resolve package:// URIs through ROS_PACKAGE_PATH: the workspace's own.
+source_workspace
 passed=0
 failed=0
 for target in "${TARGETS[@]}"; do

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 
 namespace fdml_localization
 {
@@ -47,12 +48,19 @@ public:
   void escapes();
   void multiStart();
   Candidate candidate() const;
+  /// The optima multiStart() reached (collect_ties) tying the best one's net consensus.
+  std::vector<Candidate> ties() const;
 
 private:
   /// Adopts a polished pose when it explains more readings, or as many with a lower RMS.
   bool consider(const PolishOutcome& polished)
   {
     PoseEvaluation eval = evaluatePose(map_, polished.pose, readings_, settings_.agreement_tolerance);
+    if (collecting_)
+    {
+      reached_.push_back(candidateFrom(polished.pose, eval));
+      reached_.back().covariance = polished.covariance;
+    }
     if (!evaluationBetter(eval, best_))
     {
       return false;
@@ -110,6 +118,8 @@ private:
   PoseEvaluation best_;
   const std::vector<double> seed_residuals_;
   Eigen::Matrix3d best_cov_ = Eigen::Matrix3d::Identity() * 1e6;
+  bool collecting_ = false;
+  std::vector<Candidate> reached_;  ///< every polish result of multiStart() (collect_ties)
 };
 
 /// First polish: robust, on the hypothesis minus the readings whose rays pass a vertex within
@@ -295,7 +305,8 @@ void Refiner::escapes()
 void Refiner::multiStart()
 {
   const int m = settings_.multi_start;
-  if (m <= 0 || (best_.rms <= 1e-9 && best_.inliers == static_cast<int>(readings_.size())))
+  const bool exact = best_.rms <= 1e-9 && best_.inliers == static_cast<int>(readings_.size());
+  if (m <= 0 || (exact && !settings_.collect_ties))
   {
     return;
   }
@@ -309,6 +320,7 @@ void Refiner::multiStart()
     return;
   }
   const Pose2 centre = best_pose_;
+  collecting_ = settings_.collect_ties;
   for (const Pose2& start : region_starts_)
   {
     annealFrom(start, use);
@@ -328,7 +340,17 @@ void Refiner::multiStart()
       }
     }
   }
+  collecting_ = false;
   polishRounds();
+}
+
+std::vector<Candidate> Refiner::ties() const
+{
+  std::vector<Candidate> tied;
+  const int net = best_.inliers - best_.contradicted;
+  std::copy_if(reached_.begin(), reached_.end(), std::back_inserter(tied),
+               [&](const Candidate& c) { return netConsensus(c) >= net; });
+  return tied;
 }
 
 Candidate Refiner::candidate() const
@@ -341,7 +363,7 @@ Candidate Refiner::candidate() const
 
 Candidate refineSeed(const MapRayCaster& map, const Pose2& seed, const std::vector<Reading>& readings,
                      const std::vector<bool>& hypothesis, const RefinementSettings& settings,
-                     const std::vector<Pose2>& region_starts)
+                     const std::vector<Pose2>& region_starts, std::vector<Candidate>* ties)
 {
   Refiner refiner(map, seed, readings, hypothesis, settings, region_starts);
   refiner.firstPolish();
@@ -350,6 +372,10 @@ Candidate refineSeed(const MapRayCaster& map, const Pose2& seed, const std::vect
   refiner.polishRounds();
   refiner.escapes();
   refiner.multiStart();
+  if (ties != nullptr)
+  {
+    *ties = refiner.ties();
+  }
   return refiner.candidate();
 }
 

@@ -186,9 +186,12 @@ public:
                               options.max_candidates);
     RefinementSettings with = levelSettings(level);
     with.multi_start = 1;
+    with.collect_ties = true;
     // The candidates tied at the best net consensus (those the answer rests on) get the
-    // multi-start; every candidate gets its covariance widened along continua.
+    // multi-start, which also returns the other optima of their regions tying them (a region
+    // can hold several exact poses); every candidate gets its covariance widened along continua.
     const int top = kept.empty() ? 0 : netConsensus(kept.front());
+    std::vector<std::vector<Candidate>> ties(kept.size());
 #pragma omp parallel for schedule(dynamic, 1) num_threads(ctx_.threads) if (kept.size() >= 2)
     for (std::size_t j = 0; j < kept.size(); ++j)
     {
@@ -199,18 +202,31 @@ public:
       }
       const SearchSeed& seed = seeds_[static_cast<std::size_t>(kept[j].support)];
       Candidate polished = refineSeed(ctx_.map, kept[j].pose, ctx_.readings, seed.hypothesis, with,
-                                      seed.region_starts.empty() ? seed.retry_starts : seed.region_starts);
+                                      seed.region_starts.empty() ? seed.retry_starts : seed.region_starts, &ties[j]);
       if (betterCandidate(polished, kept[j]))
       {
         polished.support = kept[j].support;
         kept[j] = std::move(polished);
       }
       widenAlongContinua(ctx_.map, ctx_.readings, ctx_.settings.noise_sigma, kept[j]);
+      ties[j] = rankAndDeduplicate(std::move(ties[j]), options.uniqueness_distance, options.uniqueness_angle,
+                                   options.max_candidates);
+      for (Candidate& tie : ties[j])
+      {
+        tie.support = kept[j].support;
+        widenAlongContinua(ctx_.map, ctx_.readings, ctx_.settings.noise_sigma, tie);
+      }
+    }
+    for (std::vector<Candidate>& found : ties)
+    {
+      std::move(found.begin(), found.end(), std::back_inserter(kept));
     }
     SeedSearchOutcome outcome;
     outcome.min_inliers_used = level;
-    outcome.candidates = rankAndDeduplicate(std::move(kept), options.uniqueness_distance, options.uniqueness_angle,
+    outcome.candidates = rankAndDeduplicate(kept, options.uniqueness_distance, options.uniqueness_angle,
                                             options.max_candidates);
+    absorbTiedDuplicates(kept, options.uniqueness_distance, options.uniqueness_angle, ctx_.settings.noise_sigma,
+                         outcome.candidates);
     for (Candidate& candidate : outcome.candidates)
     {
       const SearchSeed& seed = seeds_[static_cast<std::size_t>(candidate.support)];
@@ -301,6 +317,9 @@ int secondChances(SeedPool& pool, bool automatic, bool reached, int used_level, 
     }
     used_level = pool.bestNet();
   }
+  // Ties: every seed promising the level reached that fell short gets its second chance too (the
+  // truth's region may promise as much as a place that reached it first).
+  pool.retryFor(used_level);
   return used_level;
 }
 }  // namespace

@@ -115,15 +115,15 @@ public:
   }
 
   /// Refines, once, every seed that could reach @p level: its region explains as many readings
-  /// and at least level - 2 of them roughly agree at its start.
-  void refineFor(int level)
+  /// and at least level - @p rough_margin of them roughly agree at its start.
+  void refineFor(int level, int rough_margin = 2)
   {
     const RefinementSettings with = levelSettings(level);
     const long n = static_cast<long>(seeds_.size());
 #pragma omp parallel for schedule(dynamic, 1) num_threads(ctx_.threads) if (n >= 4)
     for (long c = 0; c < n; ++c)
     {
-      if (!refined_[c] && seeds_[c].promised >= level && rough_[c] >= level - 2)
+      if (!refined_[c] && seeds_[c].promised >= level && rough_[c] >= level - rough_margin)
       {
         refined_[c] = 1;
         keepBetter(c, refineSeed(ctx_.map, seeds_[c].start, ctx_.readings, seeds_[c].hypothesis, with));
@@ -184,12 +184,31 @@ public:
     }
     kept = rankAndDeduplicate(std::move(kept), options.uniqueness_distance, options.uniqueness_angle,
                               options.max_candidates);
+    polishTop(level, options, kept);
+    SeedSearchOutcome outcome;
+    outcome.min_inliers_used = level;
+    outcome.candidates = rankAndDeduplicate(kept, options.uniqueness_distance, options.uniqueness_angle,
+                                            options.max_candidates);
+    absorbTiedDuplicates(kept, options.uniqueness_distance, options.uniqueness_angle, ctx_.settings.noise_sigma,
+                         outcome.candidates);
+    for (Candidate& candidate : outcome.candidates)
+    {
+      const SearchSeed& seed = seeds_[static_cast<std::size_t>(candidate.support)];
+      outcome.regions.push_back(seed.region);
+      candidate.support = seed.support;
+    }
+    return outcome;
+  }
+
+private:
+  /// The candidates tied at the best net consensus (those the answer rests on) get the
+  /// multi-start, which also adds the other optima of their regions tying them (a region can
+  /// hold several exact poses); every candidate gets its covariance widened along continua.
+  void polishTop(int level, const LocalizerOptions& options, std::vector<Candidate>& kept) const
+  {
     RefinementSettings with = levelSettings(level);
     with.multi_start = 1;
     with.collect_ties = true;
-    // The candidates tied at the best net consensus (those the answer rests on) get the
-    // multi-start, which also returns the other optima of their regions tying them (a region
-    // can hold several exact poses); every candidate gets its covariance widened along continua.
     const int top = kept.empty() ? 0 : netConsensus(kept.front());
     std::vector<std::vector<Candidate>> ties(kept.size());
 #pragma omp parallel for schedule(dynamic, 1) num_threads(ctx_.threads) if (kept.size() >= 2)
@@ -221,22 +240,8 @@ public:
     {
       std::move(found.begin(), found.end(), std::back_inserter(kept));
     }
-    SeedSearchOutcome outcome;
-    outcome.min_inliers_used = level;
-    outcome.candidates = rankAndDeduplicate(kept, options.uniqueness_distance, options.uniqueness_angle,
-                                            options.max_candidates);
-    absorbTiedDuplicates(kept, options.uniqueness_distance, options.uniqueness_angle, ctx_.settings.noise_sigma,
-                         outcome.candidates);
-    for (Candidate& candidate : outcome.candidates)
-    {
-      const SearchSeed& seed = seeds_[static_cast<std::size_t>(candidate.support)];
-      outcome.regions.push_back(seed.region);
-      candidate.support = seed.support;
-    }
-    return outcome;
   }
 
-private:
   std::vector<long> retryOrder(int level, std::size_t retried) const
   {
     std::vector<long> order;
@@ -317,9 +322,9 @@ int secondChances(SeedPool& pool, bool automatic, bool reached, int used_level, 
     }
     used_level = pool.bestNet();
   }
-  // Ties: every seed promising the level reached that fell short gets its second chance too (the
-  // truth's region may promise as much as a place that reached it first).
-  pool.retryFor(used_level);
+  // Ties: every seed promising the level reached is refined, however few readings roughly agree
+  // at its start (the truth's region may promise as much as a place that reached it first).
+  pool.refineFor(used_level, used_level);
   return used_level;
 }
 }  // namespace

@@ -1,6 +1,5 @@
-// refineSeed(): from a seed pose and a hypothesis, the best pose the polish reaches (robust
-// annealing, obstacle-hit hypotheses, a local lattice search, inlier rounds, leave-one-out
-// escapes and a multi-start lattice).
+// refineSeed(): from a seed pose and a hypothesis, the best pose the polish reaches (annealing,
+// obstacle-hit hypotheses, lattice search, inlier rounds, leave-one-out escapes, multi-start).
 #include "fdml_localization/core/localization/robust_search.h"
 
 #include <algorithm>
@@ -48,12 +47,11 @@ public:
   void escapes();
   void multiStart();
   Candidate candidate() const;
-  /// The optima multiStart() reached (collect_ties) tying the best one's net consensus.
-  std::vector<Candidate> ties() const;
+  std::vector<Candidate> ties() const;  ///< the optima multiStart() reached tying the best
 
 private:
-  /// Adopts a polished pose when it explains more readings, or as many with a lower RMS.
-  bool consider(const PolishOutcome& polished)
+  /// Adopts a polished pose (or a shorter step to it) explaining more readings or a lower RMS.
+  bool consider(const PolishOutcome& polished, bool pull_back = true)
   {
     PoseEvaluation eval = evaluatePose(map_, polished.pose, readings_, settings_.agreement_tolerance);
     if (collecting_)
@@ -63,12 +61,30 @@ private:
     }
     if (!evaluationBetter(eval, best_))
     {
-      return false;
+      return pull_back && eval.contradicted > best_.contradicted && pullBack(polished);
     }
     best_ = std::move(eval);
     best_pose_ = polished.pose;
     best_cov_ = polished.covariance;
     return true;
+  }
+
+  /// The polish does not see no-return readings (nor walls its rays newly hit): a step from the
+  /// best pose that contradicts more readings is tried again at fractions of its length.
+  bool pullBack(const PolishOutcome& polished)
+  {
+    const Pose2 from = best_pose_;
+    PolishOutcome shorter = polished;
+    for (double t : { 0.75, 0.5, 0.25 })
+    {
+      shorter.pose = Pose2(from.x + t * (polished.pose.x - from.x), from.y + t * (polished.pose.y - from.y),
+                           wrapAngle(from.theta + t * angleDiff(polished.pose.theta, from.theta)));
+      if (consider(shorter, false))
+      {
+        return true;
+      }
+    }
+    return false;
   }
 
   PolishOutcome polish(const Pose2& start, const std::vector<bool>& use, double scale) const

@@ -115,19 +115,42 @@ public:
   }
 
   /// Refines, once, every seed that could reach @p level: its region explains as many readings
-  /// and at least level - @p rough_margin of them roughly agree at its start.
-  void refineFor(int level, int rough_margin = 2)
+  /// and at least level - 2 of them roughly agree at its start.
+  void refineFor(int level)
   {
     const RefinementSettings with = levelSettings(level);
     const long n = static_cast<long>(seeds_.size());
 #pragma omp parallel for schedule(dynamic, 1) num_threads(ctx_.threads) if (n >= 4)
     for (long c = 0; c < n; ++c)
     {
-      if (!refined_[c] && seeds_[c].promised >= level && rough_[c] >= level - rough_margin)
+      if (!refined_[c] && seeds_[c].promised >= level && rough_[c] >= level - 2)
       {
         refined_[c] = 1;
         keepBetter(c, refineSeed(ctx_.map, seeds_[c].start, ctx_.readings, seeds_[c].hypothesis, with));
       }
+    }
+  }
+
+  /// Refines, once, the @p most seeds promising @p level not yet refined, most agreeing first.
+  void refineRemaining(int level, std::size_t most)
+  {
+    std::vector<long> order;
+    for (long c = 0; c < static_cast<long>(seeds_.size()); ++c)
+    {
+      if (!refined_[c] && seeds_[c].promised >= level)
+      {
+        order.push_back(c);
+      }
+    }
+    std::stable_sort(order.begin(), order.end(), [&](long a, long b) { return rough_[a] > rough_[b]; });
+    order.resize(std::min(order.size(), most));
+    const RefinementSettings with = levelSettings(level);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(ctx_.threads) if (order.size() >= 4)
+    for (std::size_t j = 0; j < order.size(); ++j)
+    {
+      const long c = order[j];
+      refined_[c] = 1;
+      keepBetter(c, refineSeed(ctx_.map, seeds_[c].start, ctx_.readings, seeds_[c].hypothesis, with));
     }
   }
 
@@ -187,8 +210,8 @@ public:
     polishTop(level, options, kept);
     SeedSearchOutcome outcome;
     outcome.min_inliers_used = level;
-    outcome.candidates = rankAndDeduplicate(kept, options.uniqueness_distance, options.uniqueness_angle,
-                                            options.max_candidates);
+    outcome.candidates =
+        rankAndDeduplicate(kept, options.uniqueness_distance, options.uniqueness_angle, options.max_candidates);
     absorbTiedDuplicates(kept, options.uniqueness_distance, options.uniqueness_angle, ctx_.settings.noise_sigma,
                          outcome.candidates);
     for (Candidate& candidate : outcome.candidates)
@@ -201,9 +224,8 @@ public:
   }
 
 private:
-  /// The candidates tied at the best net consensus (those the answer rests on) get the
-  /// multi-start, which also adds the other optima of their regions tying them (a region can
-  /// hold several exact poses); every candidate gets its covariance widened along continua.
+  /// The candidates tied at the best net consensus get the multi-start, which adds the other optima
+  /// of their regions tying them; every candidate gets its covariance widened along continua.
   void polishTop(int level, const LocalizerOptions& options, std::vector<Candidate>& kept) const
   {
     RefinementSettings with = levelSettings(level);
@@ -322,9 +344,8 @@ int secondChances(SeedPool& pool, bool automatic, bool reached, int used_level, 
     }
     used_level = pool.bestNet();
   }
-  // Ties: every seed promising the level reached is refined, however few readings roughly agree
-  // at its start (the truth's region may promise as much as a place that reached it first).
-  pool.refineFor(used_level, used_level);
+  // Ties: the truth's region may promise as much as a place that reached the level first.
+  pool.refineRemaining(used_level, kRetriedSeeds);
   return used_level;
 }
 }  // namespace

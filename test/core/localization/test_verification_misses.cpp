@@ -85,6 +85,8 @@ const char* const kPastMisses[] = {
   // The grazing trial above with its truth to 10 decimals: the mirror pose's seeds were all
   // that the conservative region's best-agreeing voxels gave.
   "grazing map 0 k 4 exact truth (0.5236786662, 1.0176473813, 0.1665339564)",
+  // verify --seed 2: the polish slid along the undetermined x into a no-return contradiction.
+  "no-return map 1 k 28 exact truth (6.7708527589, 0.7193026750, -0.3401270461) max range 1.133342685",
 };
 
 class PastMisses : public ::testing::TestWithParam<Engine>

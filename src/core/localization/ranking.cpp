@@ -1,5 +1,7 @@
 #include "fdml_localization/core/localization/ranking.h"
 
+#include <Eigen/Cholesky>
+
 #include <algorithm>
 #include <cmath>
 #include <utility>
@@ -45,6 +47,28 @@ std::vector<Candidate> rankAndDeduplicate(std::vector<Candidate> candidates, dou
     }
   }
   return kept;
+}
+
+void absorbTiedDuplicates(const std::vector<Candidate>& all, double distance, double angle, double noise,
+                          std::vector<Candidate>& kept)
+{
+  for (const Candidate& c : all)
+  {
+    for (Candidate& k : kept)
+    {
+      const Eigen::Vector3d d(c.pose.x - k.pose.x, c.pose.y - k.pose.y, angleDiff(c.pose.theta, k.pose.theta));
+      if (d.head<2>().norm() >= distance || std::abs(d(2)) >= angle)
+      {
+        continue;
+      }
+      const double mahalanobis2 = d.dot(k.covariance.ldlt().solve(d));
+      if (netConsensus(c) == netConsensus(k) && c.rms_residual <= k.rms_residual + noise && !(mahalanobis2 <= 9.0))
+      {
+        k.covariance += d * d.transpose() / 8.0;
+      }
+      break;  // c is a duplicate of the first kept candidate near it (rankAndDeduplicate())
+    }
+  }
 }
 
 bool isUnambiguous(const Result& result)

@@ -1,10 +1,10 @@
-// refineSeed(): from a seed pose and a hypothesis, the best pose the polish reaches (robust
-// annealing, obstacle-hit hypotheses, a local lattice search, inlier rounds, leave-one-out
-// escapes and a multi-start lattice).
+// refineSeed(): from a seed pose and a hypothesis, the best pose the polish reaches (annealing,
+// obstacle-hit hypotheses, lattice search, inlier rounds, leave-one-out escapes, multi-start).
 #include "fdml_localization/core/localization/robust_search.h"
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 
 namespace fdml_localization
 {
@@ -47,20 +47,44 @@ public:
   void escapes();
   void multiStart();
   Candidate candidate() const;
+  std::vector<Candidate> ties() const;  ///< the optima multiStart() reached tying the best
 
 private:
-  /// Adopts a polished pose when it explains more readings, or as many with a lower RMS.
-  bool consider(const PolishOutcome& polished)
+  /// Adopts a polished pose (or a shorter step to it) explaining more readings or a lower RMS.
+  bool consider(const PolishOutcome& polished, bool pull_back = true)
   {
     PoseEvaluation eval = evaluatePose(map_, polished.pose, readings_, settings_.agreement_tolerance);
+    if (collecting_)
+    {
+      reached_.push_back(candidateFrom(polished.pose, eval));
+      reached_.back().covariance = polished.covariance;
+    }
     if (!evaluationBetter(eval, best_))
     {
-      return false;
+      return pull_back && eval.contradicted > best_.contradicted && pullBack(polished);
     }
     best_ = std::move(eval);
     best_pose_ = polished.pose;
     best_cov_ = polished.covariance;
     return true;
+  }
+
+  /// The polish does not see no-return readings (nor walls its rays newly hit): a step from the
+  /// best pose that contradicts more readings is tried again at fractions of its length.
+  bool pullBack(const PolishOutcome& polished)
+  {
+    const Pose2 from = best_pose_;
+    PolishOutcome shorter = polished;
+    for (double t : { 0.75, 0.5, 0.25 })
+    {
+      shorter.pose = Pose2(from.x + t * (polished.pose.x - from.x), from.y + t * (polished.pose.y - from.y),
+                           wrapAngle(from.theta + t * angleDiff(polished.pose.theta, from.theta)));
+      if (consider(shorter, false))
+      {
+        return true;
+      }
+    }
+    return false;
   }
 
   PolishOutcome polish(const Pose2& start, const std::vector<bool>& use, double scale) const
@@ -110,6 +134,8 @@ private:
   PoseEvaluation best_;
   const std::vector<double> seed_residuals_;
   Eigen::Matrix3d best_cov_ = Eigen::Matrix3d::Identity() * 1e6;
+  bool collecting_ = false;
+  std::vector<Candidate> reached_;  ///< every polish result of multiStart() (collect_ties)
 };
 
 /// First polish: robust, on the hypothesis minus the readings whose rays pass a vertex within
@@ -295,7 +321,8 @@ void Refiner::escapes()
 void Refiner::multiStart()
 {
   const int m = settings_.multi_start;
-  if (m <= 0 || (best_.rms <= 1e-9 && best_.inliers == static_cast<int>(readings_.size())))
+  const bool exact = best_.rms <= 1e-9 && best_.inliers == static_cast<int>(readings_.size());
+  if (m <= 0 || (exact && !settings_.collect_ties))
   {
     return;
   }
@@ -309,6 +336,7 @@ void Refiner::multiStart()
     return;
   }
   const Pose2 centre = best_pose_;
+  collecting_ = settings_.collect_ties;
   for (const Pose2& start : region_starts_)
   {
     annealFrom(start, use);
@@ -328,7 +356,17 @@ void Refiner::multiStart()
       }
     }
   }
+  collecting_ = false;
   polishRounds();
+}
+
+std::vector<Candidate> Refiner::ties() const
+{
+  std::vector<Candidate> tied;
+  const int net = best_.inliers - best_.contradicted;
+  std::copy_if(reached_.begin(), reached_.end(), std::back_inserter(tied),
+               [&](const Candidate& c) { return netConsensus(c) >= net; });
+  return tied;
 }
 
 Candidate Refiner::candidate() const
@@ -341,7 +379,7 @@ Candidate Refiner::candidate() const
 
 Candidate refineSeed(const MapRayCaster& map, const Pose2& seed, const std::vector<Reading>& readings,
                      const std::vector<bool>& hypothesis, const RefinementSettings& settings,
-                     const std::vector<Pose2>& region_starts)
+                     const std::vector<Pose2>& region_starts, std::vector<Candidate>* ties)
 {
   Refiner refiner(map, seed, readings, hypothesis, settings, region_starts);
   refiner.firstPolish();
@@ -350,6 +388,10 @@ Candidate refineSeed(const MapRayCaster& map, const Pose2& seed, const std::vect
   refiner.polishRounds();
   refiner.escapes();
   refiner.multiStart();
+  if (ties != nullptr)
+  {
+    *ties = refiner.ties();
+  }
   return refiner.candidate();
 }
 

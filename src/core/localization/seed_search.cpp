@@ -140,6 +140,29 @@ public:
     }
   }
 
+  /// Refines, once, the @p most seeds promising @p level not yet refined, most agreeing first.
+  void refineRemaining(int level, std::size_t most)
+  {
+    std::vector<long> order;
+    for (long c = 0; c < static_cast<long>(seeds_.size()); ++c)
+    {
+      if (!refined_[c] && seeds_[c].promised >= level)
+      {
+        order.push_back(c);
+      }
+    }
+    std::stable_sort(order.begin(), order.end(), [&](long a, long b) { return rough_[a] > rough_[b]; });
+    order.resize(std::min(order.size(), most));
+    const RefinementSettings with = levelSettings(level);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(ctx_.threads) if (order.size() >= 4)
+    for (std::size_t j = 0; j < order.size(); ++j)
+    {
+      const long c = order[j];
+      refined_[c] = 1;
+      keepBetter(c, refineSeed(ctx_.map, seeds_[c].start, ctx_.readings, seeds_[c].hypothesis, with));
+    }
+  }
+
   /**
    * @brief Second chances for the seeds that promise @p level but fell short: the optimum may
    *        lie across an occlusion edge from the start, where no descent reaches it, or far from
@@ -193,33 +216,13 @@ public:
     }
     kept = rankAndDeduplicate(std::move(kept), options.uniqueness_distance, options.uniqueness_angle,
                               options.max_candidates);
-    RefinementSettings with = levelSettings(level);
-    with.multi_start = 1;
-    // The candidates tied at the best net consensus (those the answer rests on) get the
-    // multi-start; every candidate gets its covariance widened along continua.
-    const int top = kept.empty() ? 0 : netConsensus(kept.front());
-#pragma omp parallel for schedule(dynamic, 1) num_threads(ctx_.threads) if (kept.size() >= 2)
-    for (std::size_t j = 0; j < kept.size(); ++j)
-    {
-      if (netConsensus(kept[j]) < top)
-      {
-        widenAlongContinua(ctx_.map, ctx_.readings, ctx_.settings.noise_sigma, kept[j]);
-        continue;
-      }
-      const SearchSeed& seed = seeds_[static_cast<std::size_t>(kept[j].support)];
-      Candidate polished = refineSeed(ctx_.map, kept[j].pose, ctx_.readings, seed.hypothesis, with,
-                                      seed.region_starts.empty() ? seed.retry_starts : seed.region_starts);
-      if (betterCandidate(polished, kept[j]))
-      {
-        polished.support = kept[j].support;
-        kept[j] = std::move(polished);
-      }
-      widenAlongContinua(ctx_.map, ctx_.readings, ctx_.settings.noise_sigma, kept[j]);
-    }
+    polishTop(level, options, kept);
     SeedSearchOutcome outcome;
     outcome.min_inliers_used = level;
-    outcome.candidates = rankAndDeduplicate(std::move(kept), options.uniqueness_distance, options.uniqueness_angle,
-                                            options.max_candidates);
+    outcome.candidates =
+        rankAndDeduplicate(kept, options.uniqueness_distance, options.uniqueness_angle, options.max_candidates);
+    absorbTiedDuplicates(kept, options.uniqueness_distance, options.uniqueness_angle, ctx_.settings.noise_sigma,
+                         outcome.candidates);
     for (Candidate& candidate : outcome.candidates)
     {
       const SearchSeed& seed = seeds_[static_cast<std::size_t>(candidate.support)];
@@ -230,6 +233,46 @@ public:
   }
 
 private:
+  /// The candidates tied at the best net consensus get the multi-start, which adds the other optima
+  /// of their regions tying them; every candidate gets its covariance widened along continua.
+  void polishTop(int level, const LocalizerOptions& options, std::vector<Candidate>& kept) const
+  {
+    RefinementSettings with = levelSettings(level);
+    with.multi_start = 1;
+    with.collect_ties = true;
+    const int top = kept.empty() ? 0 : netConsensus(kept.front());
+    std::vector<std::vector<Candidate>> ties(kept.size());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(ctx_.threads) if (kept.size() >= 2)
+    for (std::size_t j = 0; j < kept.size(); ++j)
+    {
+      if (netConsensus(kept[j]) < top)
+      {
+        widenAlongContinua(ctx_.map, ctx_.readings, ctx_.settings.noise_sigma, kept[j]);
+        continue;
+      }
+      const SearchSeed& seed = seeds_[static_cast<std::size_t>(kept[j].support)];
+      Candidate polished = refineSeed(ctx_.map, kept[j].pose, ctx_.readings, seed.hypothesis, with,
+                                      seed.region_starts.empty() ? seed.retry_starts : seed.region_starts, &ties[j]);
+      if (betterCandidate(polished, kept[j]))
+      {
+        polished.support = kept[j].support;
+        kept[j] = std::move(polished);
+      }
+      widenAlongContinua(ctx_.map, ctx_.readings, ctx_.settings.noise_sigma, kept[j]);
+      ties[j] = rankAndDeduplicate(std::move(ties[j]), options.uniqueness_distance, options.uniqueness_angle,
+                                   options.max_candidates);
+      for (Candidate& tie : ties[j])
+      {
+        tie.support = kept[j].support;
+        widenAlongContinua(ctx_.map, ctx_.readings, ctx_.settings.noise_sigma, tie);
+      }
+    }
+    for (std::vector<Candidate>& found : ties)
+    {
+      std::move(found.begin(), found.end(), std::back_inserter(kept));
+    }
+  }
+
   std::vector<long> retryOrder(int level, std::size_t retried) const
   {
     std::vector<long> order;
@@ -315,6 +358,8 @@ int secondChances(SeedPool& pool, bool automatic, bool reached, int used_level, 
     }
     used_level = pool.bestNet();
   }
+  // Ties: the truth's region may promise as much as a place that reached the level first.
+  pool.refineRemaining(used_level, kRetriedSeeds);
   return used_level;
 }
 }  // namespace

@@ -303,6 +303,31 @@ inline void checkNoiseFree(const Localizer& localizer, const Trial& trial, const
   }
 }
 
+/// What reproduces a trial: map, geometry, k, truth, and the max range (no-return) or the
+/// headings (random directions) that the truth alone does not give.
+inline std::string trialLabel(const Trial& trial, int k)
+{
+  char text[160];
+  std::snprintf(text, sizeof(text), "%s map %d k %d %s truth (%.10f, %.10f, %.10f)", geometryName(trial.geometry),
+                trial.map, k, trial.noisy ? "noisy" : "exact", trial.truth.x, trial.truth.y, trial.truth.theta);
+  std::string label = text;
+  if (trial.geometry == kNoReturn && !trial.readings.empty())
+  {
+    std::snprintf(text, sizeof(text), " max range %.9f", trial.readings.front().max_range);
+    label += text;
+  }
+  if (trial.geometry == kRandom)
+  {
+    label += " headings";
+    for (const Reading& r : trial.readings)
+    {
+      std::snprintf(text, sizeof(text), " %.9f", r.offset.theta);
+      label += text;
+    }
+  }
+  return label;
+}
+
 /// Runs one trial on @p localizer and adds it to @p figures.
 inline void runTrial(Localizer& localizer, const Trial& trial, int reference_samples, std::mt19937_64& rng,
                      Figures& figures)
@@ -313,9 +338,7 @@ inline void runTrial(Localizer& localizer, const Trial& trial, int reference_sam
   figures.seconds += result.times.total;
   figures.complete += result.certificate.complete ? 1 : 0;
   const int k = static_cast<int>(trial.readings.size());
-  char label[160];
-  std::snprintf(label, sizeof(label), "%s map %d k %d %s truth (%.6f, %.6f, %.6f)", geometryName(trial.geometry),
-                trial.map, k, trial.noisy ? "noisy" : "exact", trial.truth.x, trial.truth.y, trial.truth.theta);
+  const std::string label = trialLabel(trial, k);
   if (!result.candidates.empty() && isTruths(result.candidates[0], trial.truth))
   {
     ++figures.top1;

@@ -42,6 +42,16 @@ std::vector<Candidate> rankAndDeduplicate(std::vector<Candidate> candidates, dou
                                           int max_candidates);
 
 /**
+ * @brief Two optima closer than (@p distance, @p angle) are one candidate, but when they tie
+ *        (same net consensus, RMS within @p noise [m]) the answer may be either: each candidate of
+ *        @p kept (the deduplicated list) widens its covariance until it covers, within 3
+ *        standard deviations, every candidate of @p all (the list before deduplication) that
+ *        ties it and was dropped as its duplicate.
+ */
+void absorbTiedDuplicates(const std::vector<Candidate>& all, double distance, double angle, double noise,
+                          std::vector<Candidate>& kept);
+
+/**
  * @brief The one ambiguity rule: a result's best candidate is unambiguous when it is the only
  *        candidate, or when its net consensus is strictly larger than the second's. Candidates
  *        tied on net consensus are different places that explain the readings equally well

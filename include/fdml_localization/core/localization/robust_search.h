@@ -94,6 +94,10 @@ struct RefinementSettings
                                           ///< a lattice around the best pose; 0 = none
   double multi_start_step = 0.05;         ///< lattice step of the multi-start in x, y [m]
   double multi_start_angle_step = 0.02;   ///< ... and in theta [rad]
+  /// With multi_start: run it even from an exact pose, and return every distinct optimum it
+  /// reaches with the best one's net consensus (refineSeed()'s @p ties): several exact poses
+  /// can share one region (a mirror heading a few cells away).
+  bool collect_ties = false;
 };
 
 /**
@@ -110,12 +114,13 @@ struct RefinementSettings
  *           escape the false minima that corners create in the piecewise-smooth cost;
  *        5. optionally (multi_start) annealed polishes from @p region_starts (poses spread over
  *           the seed's region) and robust polishes from a lattice of poses around the best one,
- *           on the hypothesis's finite readings, keeping the best (most inliers, then least RMS).
+ *           on the hypothesis's finite readings, keeping the best (most inliers, then least RMS);
+ *           with settings.collect_ties, the other optima tying its net consensus go to @p ties.
  *        Never returns a pose worse than the seed.
  */
 Candidate refineSeed(const MapRayCaster& map, const Pose2& seed, const std::vector<Reading>& readings,
                      const std::vector<bool>& hypothesis, const RefinementSettings& settings,
-                     const std::vector<Pose2>& region_starts = {});
+                     const std::vector<Pose2>& region_starts = {}, std::vector<Candidate>* ties = nullptr);
 
 /**
  * @brief For each reading, how close its ray from @p pose passes to a map vertex, relative to

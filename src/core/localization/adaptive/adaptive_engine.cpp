@@ -4,6 +4,7 @@
 
 #include "fdml_localization/core/localization/certificate.h"
 #include "fdml_localization/core/localization/ranking.h"
+#include "fdml_localization/core/localization/region_starts.h"
 #include "fdml_localization/core/localization/robust_search.h"
 #include "fdml_localization/core/localization/seed_search.h"
 #include "fdml_localization/core/util/stopwatch.h"
@@ -26,6 +27,9 @@ constexpr std::size_t kRegionStarts = 12;
 constexpr std::size_t kSeedsPerPlateau = 3;
 /// ... from plateaus of at least this many leaves (smaller ones give one seed).
 constexpr std::size_t kLargePlateau = 16;
+/// Leaves of a plateau (spread over it) scored for its seeds: a plateau with few finite
+/// readings can be large and its exact poses few.
+constexpr std::size_t kSampledLeaves = 256;
 
 std::vector<bool> hypothesisOf(const LeafBox& leaf, std::size_t k)
 {
@@ -38,59 +42,26 @@ std::vector<bool> hypothesisOf(const LeafBox& leaf, std::size_t k)
 }
 
 /**
- * The plateau leaves (of at most kSampledLeaves spread over it, plus its centroid) whose centres
- * agree best with the readings (fewest readings off by more than @p gate, then smallest squared
- * residuals), at most @p max_seeds of them and pairwise apart by more than @p separation_xy [m]
- * or @p separation_theta [rad]. A large plateau (few finite readings constrain it) can hold
- * several distinct optima and its centroid can lie far from all of them.
+ * The plateau's leaves (centres; of at most kSampledLeaves spread over it, plus its centroid)
+ * agreeing best with the readings (bestAgreeingPoses()), at most @p max_seeds.
  */
 std::vector<Pose2> plateauSeeds(const MapRayCaster& map, const std::vector<LeafBox>& leaves, const LeafCluster& cluster,
                                 const std::vector<Reading>& readings, double gate, double separation_xy,
                                 double separation_theta, std::size_t max_seeds)
 {
-  constexpr std::size_t kSampledLeaves = 32;
   if (cluster.members.size() < 2)
   {
     return { cluster.centroid };
   }
-  std::vector<std::pair<double, Pose2>> scored;
   const std::size_t n = cluster.members.size();
   const std::size_t samples = std::min(n, kSampledLeaves);
-  for (std::size_t s = 0; s <= samples; ++s)
+  std::vector<Pose2> poses;
+  for (std::size_t s = 0; s < samples; ++s)
   {
-    const Pose2 pose = s == samples ? cluster.centroid : leaves[cluster.members[s * n / samples]].box.centre();
-    const PoseEvaluation e = evaluatePose(map, pose, readings, gate);
-    double score = static_cast<double>(readings.size() - e.inliers) * gate * gate;
-    for (std::size_t i = 0; i < readings.size(); ++i)
-    {
-      if (e.inlier_mask[i] && std::isfinite(e.residuals[i]))
-      {
-        score += e.residuals[i] * e.residuals[i];
-      }
-    }
-    scored.emplace_back(score, pose);
+    poses.push_back(leaves[cluster.members[s * n / samples]].box.centre());
   }
-  std::stable_sort(
-      scored.begin(), scored.end(),
-      [](const std::pair<double, Pose2>& a, const std::pair<double, Pose2>& b) { return a.first < b.first; });
-  std::vector<Pose2> seeds;
-  for (const auto& entry : scored)
-  {
-    const Pose2& p = entry.second;
-    const bool distinct = std::all_of(seeds.begin(), seeds.end(), [&](const Pose2& q) {
-      return (p.position() - q.position()).norm() > separation_xy ||
-             std::abs(angleDiff(p.theta, q.theta)) > separation_theta;
-    });
-    if (distinct)
-    {
-      seeds.push_back(p);
-    }
-    if (seeds.size() >= max_seeds)
-    {
-      break;
-    }
-  }
-  return seeds;
+  poses.push_back(cluster.centroid);
+  return bestAgreeingPoses(map, poses, readings, gate, separation_xy, separation_theta, max_seeds, poses.size());
 }
 
 /// The adaptive engine's seeds, level by level: the best-agreeing distinct leaves of each

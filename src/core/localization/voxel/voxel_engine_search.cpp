@@ -7,6 +7,7 @@
 #include "fdml_localization/core/localization/seed_search.h"
 #include "fdml_localization/core/localization/components.h"
 #include "fdml_localization/core/localization/hypothesis_seeds.h"
+#include "fdml_localization/core/localization/region_starts.h"
 #include "fdml_localization/core/util/stopwatch.h"
 
 #include <omp.h>
@@ -22,17 +23,27 @@ namespace core
 {
 namespace
 {
+/// Voxels of a plateau (spread over it) the final multi-start polishes from.
+constexpr std::size_t kRegionStarts = 12;
+/// Voxels of a conservative regional maximum (spread over it) scored for its seeds ...
+constexpr std::size_t kSampledVoxels = 512;
+/// ... which gives three distinct seeds from this many voxels on (smaller ones one).
+constexpr std::size_t kLargePlateau = 16;
+
 /// The voxel engine's seeds, level by level: every locally maximal set of readings of the
 /// seeding's sample preimages (hypothesis_seeds.h) and, because that test can miss the truth's
 /// voxel next to a discontinuity of h, the count peaks of their dilation.
 class VoxelSeeds : public SeedSource
 {
 public:
-  VoxelSeeds(const VoxelEngine& engine, int lowest, int k, StageTimes& times) : engine_(engine), times_(times)
+  VoxelSeeds(const VoxelEngine& engine, const MapRayCaster& map, const std::vector<Reading>& readings, double gate,
+             int lowest, int k, StageTimes& times)
+    : engine_(engine), map_(map), readings_(readings), gate_(gate), times_(times)
   {
     const auto stage = std::chrono::steady_clock::now();
     buckets_ = voxelsByCount(engine.lastSeedCount(), lowest, k);
     raw_buckets_ = voxelsByCount(engine.lastRawCount(), lowest, k);
+    conservative_buckets_ = voxelsByCount(engine.lastCount(), lowest, k);
     times_.components += secondsSince(stage);
   }
 
@@ -50,11 +61,38 @@ public:
     {
       seeds.push_back(seedOf(c, engine_.membership(c.representative, engine_.lastSeedPreimages())));
     }
+    addConservativeSeeds(level, seeds);
     times_.components += secondsSince(stage);
     return seeds;
   }
 
 private:
+  /// The sample tests can miss the truth's voxel next to a discontinuity of h; the conservative
+  /// count field never does: each of its regional maxima also gives the voxels (of some spread
+  /// over it) agreeing best with the readings.
+  void addConservativeSeeds(int level, std::vector<SearchSeed>& seeds) const
+  {
+    const GridSpec& spec = engine_.grid();
+    for (VoxelCluster& c : regionalMaxima(spec, engine_.lastCount(), level, conservative_buckets_[level]))
+    {
+      const std::size_t n = c.voxels.size();
+      const std::size_t samples = std::min(n, kSampledVoxels);
+      std::vector<Pose2> poses;
+      for (std::size_t s = 0; s < samples; ++s)
+      {
+        poses.push_back(spec.centre(c.voxels[s * n / samples]));
+      }
+      poses.push_back(c.centroid);
+      const std::vector<bool> hypothesis = engine_.membership(c.representative, engine_.lastPreimages());
+      for (const Pose2& start : bestAgreeingPoses(map_, poses, readings_, gate_, 2.0 * spec.cell,
+                                                  2.0 * spec.thetaStep(), n >= kLargePlateau ? 3 : 1, poses.size()))
+      {
+        seeds.push_back(seedOf(c, hypothesis));
+        seeds.back().start = start;
+      }
+    }
+  }
+
   SearchSeed seedOf(const VoxelCluster& plateau, std::vector<bool> hypothesis) const
   {
     SearchSeed seed;
@@ -67,11 +105,21 @@ private:
     {
       seed.retry_starts.push_back(engine_.grid().centre(v));
     }
+    // The final multi-start's poses, spread over the plateau: it may hold several optima.
+    const std::size_t spread = std::min(n, kRegionStarts);
+    for (std::size_t j = 0; j < spread; ++j)
+    {
+      seed.region_starts.push_back(engine_.grid().centre(plateau.voxels[j * n / spread]));
+    }
     return seed;
   }
 
   const VoxelEngine& engine_;
+  const MapRayCaster& map_;
+  const std::vector<Reading>& readings_;
+  double gate_;
   StageTimes& times_;
+  std::vector<std::vector<std::size_t>> conservative_buckets_;
   std::vector<std::vector<std::size_t>> buckets_;
   std::vector<std::vector<std::size_t>> raw_buckets_;
 };
@@ -109,7 +157,8 @@ void VoxelEngine::localizeRobust(const std::vector<Reading>& readings, Result& r
 {
   const int k = static_cast<int>(readings.size());
   const int lowest = options_.min_inliers > 0 ? options_.min_inliers : 3;
-  VoxelSeeds seeds(*this, lowest, k, result.times);
+  VoxelSeeds seeds(*this, *map_, readings, seedGate(readings, options_, SeedScale{ spec_.cell, spec_.thetaStep() }),
+                   lowest, k, result.times);
   SeedSearchOutcome found =
       robustSearch(seeds, *map_, readings, options_, SeedScale{ spec_.cell, spec_.thetaStep() }, result.times);
   result.min_inliers_used = found.min_inliers_used;

@@ -1,0 +1,30 @@
+/**
+ * @file region_starts.h
+ * @brief Where to start refinements inside a region of the search (a plateau of voxels or
+ *        leaves): the region's poses that agree best with the readings. A large region (few
+ *        finite readings constrain it) can hold several distinct optima, and its centroid can lie
+ *        far from all of them.
+ */
+#pragma once
+
+#include "fdml_localization/core/localization/robust_search.h"
+
+#include <cstddef>
+#include <vector>
+
+namespace fdml_localization
+{
+namespace core
+{
+/**
+ * @brief Of @p poses (of at most @p sampled of them spread over the list), those agreeing best
+ *        with @p readings (fewest readings off by more than @p gate [m], then the smallest sum of
+ *        squared residuals), at most @p max_poses, pairwise apart by more than @p separation_xy
+ *        [m] or @p separation_theta [rad]; best first.
+ */
+std::vector<Pose2> bestAgreeingPoses(const MapRayCaster& map, const std::vector<Pose2>& poses,
+                                     const std::vector<Reading>& readings, double gate, double separation_xy,
+                                     double separation_theta, std::size_t max_poses, std::size_t sampled);
+
+}  // namespace core
+}  // namespace fdml_localization

@@ -1,0 +1,56 @@
+#include "fdml_localization/core/localization/region_starts.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace fdml_localization
+{
+namespace core
+{
+std::vector<Pose2> bestAgreeingPoses(const MapRayCaster& map, const std::vector<Pose2>& poses,
+                                     const std::vector<Reading>& readings, double gate, double separation_xy,
+                                     double separation_theta, std::size_t max_poses, std::size_t sampled)
+{
+  std::vector<std::pair<double, Pose2>> scored;
+  const std::size_t n = poses.size();
+  const std::size_t samples = std::min(n, sampled);
+  for (std::size_t s = 0; s < samples; ++s)
+  {
+    const Pose2& pose = poses[s * n / samples];
+    const PoseEvaluation e = evaluatePose(map, pose, readings, gate);
+    double score = static_cast<double>(readings.size() - e.inliers) * gate * gate;
+    for (std::size_t i = 0; i < readings.size(); ++i)
+    {
+      if (e.inlier_mask[i] && std::isfinite(e.residuals[i]))
+      {
+        score += e.residuals[i] * e.residuals[i];
+      }
+    }
+    scored.emplace_back(score, pose);
+  }
+  std::stable_sort(
+      scored.begin(), scored.end(),
+      [](const std::pair<double, Pose2>& a, const std::pair<double, Pose2>& b) { return a.first < b.first; });
+  std::vector<Pose2> best;
+  for (const auto& entry : scored)
+  {
+    const Pose2& p = entry.second;
+    const bool distinct = std::all_of(best.begin(), best.end(), [&](const Pose2& q) {
+      return (p.position() - q.position()).norm() > separation_xy ||
+             std::abs(angleDiff(p.theta, q.theta)) > separation_theta;
+    });
+    if (distinct)
+    {
+      best.push_back(p);
+    }
+    if (best.size() >= max_poses)
+    {
+      break;
+    }
+  }
+  return best;
+}
+
+}  // namespace core
+}  // namespace fdml_localization

@@ -8,6 +8,33 @@ namespace fdml_localization
 {
 namespace core
 {
+namespace
+{
+double medianFiniteRange(const std::vector<Reading>& readings)
+{
+  std::vector<double> finite;
+  for (const Reading& r : readings)
+  {
+    if (std::isfinite(r.range))
+    {
+      finite.push_back(r.range);
+    }
+  }
+  if (finite.empty())
+  {
+    return 1.0;
+  }
+  std::nth_element(finite.begin(), finite.begin() + finite.size() / 2, finite.end());
+  return finite[finite.size() / 2];
+}
+}  // namespace
+
+double seedGate(const std::vector<Reading>& readings, const LocalizerOptions& options, const SeedScale& scale)
+{
+  return 3.0 * std::max(options.agreement_tolerance,
+                        0.5 * scale.cell_xy + 0.5 * scale.cell_theta * medianFiniteRange(readings));
+}
+
 std::vector<Pose2> bestAgreeingPoses(const MapRayCaster& map, const std::vector<Pose2>& poses,
                                      const std::vector<Reading>& readings, double gate, double separation_xy,
                                      double separation_theta, std::size_t max_poses, std::size_t sampled)

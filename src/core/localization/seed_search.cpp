@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <optional>
 #include <cmath>
 #include <iterator>
 #include <numeric>
@@ -32,33 +31,10 @@ struct SearchContext
   RefinementSettings settings;
   double loose_gate = 0.0;  ///< agreement band of the rough count at a seed's start [m]
   int threads = 1;
-  /// LocalizerOptions::deadline as a time point (none when the deadline is 0): seeds not yet
-  /// refined by then are left unrefined.
-  std::optional<std::chrono::steady_clock::time_point> deadline;
-
-  bool outOfTime() const
-  {
-    return deadline && std::chrono::steady_clock::now() > *deadline;
-  }
+  /// LocalizerOptions::deadline from the search's start: seeds not yet refined by then are left
+  /// unrefined.
+  Deadline deadline;
 };
-
-double medianFiniteRange(const std::vector<Reading>& readings)
-{
-  std::vector<double> finite;
-  for (const Reading& r : readings)
-  {
-    if (std::isfinite(r.range))
-    {
-      finite.push_back(r.range);
-    }
-  }
-  if (finite.empty())
-  {
-    return 1.0;
-  }
-  std::nth_element(finite.begin(), finite.begin() + finite.size() / 2, finite.end());
-  return finite[finite.size() / 2];
-}
 
 /// The seeds and what became of them, in the order they were supplied.
 class SeedPool
@@ -132,7 +108,7 @@ public:
 #pragma omp parallel for schedule(dynamic, 1) num_threads(ctx_.threads) if (n >= 4)
     for (long c = 0; c < n; ++c)
     {
-      if (!refined_[c] && seeds_[c].promised >= level && rough_[c] >= level - 2 && !ctx_.outOfTime())
+      if (!refined_[c] && seeds_[c].promised >= level && rough_[c] >= level - 2 && !ctx_.deadline.passed())
       {
         refined_[c] = 1;
         keepBetter(c, refineSeed(ctx_.map, seeds_[c].start, ctx_.readings, seeds_[c].hypothesis, with));
@@ -317,12 +293,7 @@ private:
 SearchContext makeContext(const MapRayCaster& map, const std::vector<Reading>& readings,
                           const LocalizerOptions& options, const SeedScale& scale)
 {
-  SearchContext ctx{ map, readings, scale, RefinementSettings(), 0.0, 1, std::nullopt };
-  if (options.deadline > 0.0)
-  {
-    ctx.deadline = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                          std::chrono::duration<double>(options.deadline));
-  }
+  SearchContext ctx{ map, readings, scale, RefinementSettings(), 0.0, 1, Deadline(options.deadline) };
   ctx.threads = options.threads > 0 ? options.threads : omp_get_max_threads();
   ctx.settings.agreement_tolerance = options.agreement_tolerance;
   ctx.settings.robust_scale = seedGate(readings, options, scale) / 3.0;
@@ -364,12 +335,6 @@ int secondChances(SeedPool& pool, bool automatic, bool reached, int used_level, 
 }
 }  // namespace
 
-double seedGate(const std::vector<Reading>& readings, const LocalizerOptions& options, const SeedScale& scale)
-{
-  return 3.0 * std::max(options.agreement_tolerance,
-                        0.5 * scale.cell_xy + 0.5 * scale.cell_theta * medianFiniteRange(readings));
-}
-
 SeedSearchOutcome robustSearch(SeedSource& source, const MapRayCaster& map, const std::vector<Reading>& readings,
                                const LocalizerOptions& options, const SeedScale& scale, StageTimes& times)
 {
@@ -404,7 +369,7 @@ SeedSearchOutcome robustSearch(SeedSource& source, const MapRayCaster& map, cons
       reached = static_cast<int>(pool.distinctReaching(level, options)) >= options.max_candidates;
     }
     // The deadline (LocalizerOptions) stops the descent: the candidates found so far are ranked.
-    out_of_time = !reached && ctx.outOfTime();
+    out_of_time = !reached && ctx.deadline.passed();
   }
   if (out_of_time)
   {

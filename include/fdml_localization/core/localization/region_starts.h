@@ -1,12 +1,13 @@
 /**
  * @file region_starts.h
- * @brief Where to start refinements inside a region of the search (a plateau of voxels or
- *        leaves): the region's poses that agree best with the readings. A large region (few
- *        finite readings constrain it) can hold several distinct optima, and its centroid can lie
- *        far from all of them.
+ * @brief The seeds' agreement gate, and where to start refinements inside a region of the
+ *        search (a plateau of voxels or leaves): the region's poses that agree best with the
+ *        readings. A large region (few finite readings constrain it) can hold several distinct
+ *        optima, and its centroid can lie far from all of them.
  */
 #pragma once
 
+#include "fdml_localization/core/localization/localizer.h"
 #include "fdml_localization/core/localization/robust_search.h"
 
 #include <cstddef>
@@ -16,6 +17,21 @@ namespace fdml_localization
 {
 namespace core
 {
+/// The scale of an engine's seeds: how far a seed may lie from the optimum.
+struct SeedScale
+{
+  double cell_xy = 0.1;     ///< cell or leaf size [m]
+  double cell_theta = 0.1;  ///< cell or leaf size [rad]
+};
+
+/**
+ * @brief The loose agreement band [m] at a seed's start: 3 x the robust scale of the first
+ *        polish, max(eps, half a cell + half a cell's angle x the median finite range). Seeds
+ *        where fewer than level - 2 readings agree within it are not refined; engines use it to
+ *        pick their best starts.
+ */
+double seedGate(const std::vector<Reading>& readings, const LocalizerOptions& options, const SeedScale& scale);
+
 /**
  * @brief Of @p poses (of at most @p sampled of them spread over the list), those agreeing best
  *        with @p readings (fewest readings off by more than @p gate [m], then the smallest sum of

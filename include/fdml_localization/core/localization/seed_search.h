@@ -9,6 +9,7 @@
 #pragma once
 
 #include "fdml_localization/core/localization/localizer.h"
+#include "fdml_localization/core/localization/region_starts.h"
 #include "fdml_localization/core/localization/robust_search.h"
 
 #include <cstddef>
@@ -46,13 +47,6 @@ public:
   }
 };
 
-/// The scale of an engine's seeds: how far a seed may lie from the optimum.
-struct SeedScale
-{
-  double cell_xy = 0.1;     ///< cell or leaf size [m]
-  double cell_theta = 0.1;  ///< cell or leaf size [rad]
-};
-
 /// The outcome of robustSearch().
 struct SeedSearchOutcome
 {
@@ -60,14 +54,6 @@ struct SeedSearchOutcome
   std::vector<std::size_t> regions;   ///< per candidate: SearchSeed::region of its seed
   int min_inliers_used = 3;           ///< k' used
 };
-
-/**
- * @brief The loose agreement band [m] at a seed's start: 3 x the robust scale of the first
- *        polish, max(eps, half a cell + half a cell's angle x the median finite range). Seeds
- *        where fewer than level - 2 readings agree within it are not refined; engines use it to
- *        pick their best starts.
- */
-double seedGate(const std::vector<Reading>& readings, const LocalizerOptions& options, const SeedScale& scale);
 
 /**
  * @brief The robust method over an engine's seeds: levels from k down to the lowest allowed

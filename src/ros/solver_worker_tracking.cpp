@@ -171,7 +171,7 @@ core::Result SolverWorker::trackedResult(const Job& job) const
     core::Candidate c = h.last_fix;
     c.pose = core::compose(h.map_to_odom, job.batch.base_first);
     c.support = h.support;
-    c.covariance = h.covariance;
+    c.covariance = h.robust_covariance;
     c.inlier_mask.resize(job.readings.size(), false);
     result.candidates.push_back(c);
   }

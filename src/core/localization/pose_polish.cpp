@@ -5,6 +5,7 @@
 #include "fdml_localization/core/geometry/cone_cast.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
 #include <algorithm>
@@ -229,6 +230,55 @@ PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std:
   }
   out.covariance = poseCovariance(map, buildSystem(map, out.pose, readings, mounts, use, 0.0, hints), noise_sigma);
   return out;
+}
+
+Eigen::Matrix3d oneDirectionLostCovariance(const MapRayCaster& map, const Pose2& pose,
+                                           const std::vector<Reading>& readings, const std::vector<bool>& use,
+                                           double noise_sigma, double group_angle)
+{
+  // Each reading's own row of the normal equations (one cast each), then sums over subsets.
+  std::vector<System> rows(readings.size());
+  System all;
+  for (std::size_t i = 0; i < readings.size(); ++i)
+  {
+    std::vector<bool> only(readings.size(), false);
+    only[i] = use[i];
+    std::vector<Rotation> mounts(readings.size(), Rotation(0.0));
+    mounts[i] = Rotation(readings[i].offset.theta);
+    std::vector<Vec2> hints(readings.size(), Vec2::Constant(std::numeric_limits<double>::quiet_NaN()));
+    rows[i] = buildSystem(map, pose, readings, mounts, only, 0.0, hints);
+    all.jtj += rows[i].jtj;
+    all.sum_sq += rows[i].sum_sq;
+    all.used += rows[i].used;
+  }
+  const Eigen::Matrix3d with_all = poseCovariance(map, all, noise_sigma);
+  Eigen::Matrix3d worst = with_all;
+  for (std::size_t i = 0; i < readings.size(); ++i)
+  {
+    if (rows[i].used == 0)
+    {
+      continue;
+    }
+    System rest = all;  // the noise estimated from every reading
+    for (std::size_t j = 0; j < readings.size(); ++j)
+    {
+      if (std::abs(angleDiff(readings[j].offset.theta, readings[i].offset.theta)) <= group_angle)
+      {
+        rest.jtj -= rows[j].jtj;
+      }
+    }
+    const Eigen::Matrix3d without = poseCovariance(map, rest, noise_sigma);
+    if (without.determinant() > worst.determinant())
+    {
+      worst = without;
+    }
+  }
+  // Two directions fixing the pose equally: without either, twice the covariance; half of it
+  // is what they give together, so nothing is added. Only what exceeds that (a direction one
+  // group fixes alone, or nearly) is: the positive part of worst / 2 - with_all.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> excess(0.5 * worst - with_all);
+  const Eigen::Vector3d kept = excess.eigenvalues().cwiseMax(0.0);
+  return excess.eigenvectors() * kept.asDiagonal() * excess.eigenvectors().transpose();
 }
 
 }  // namespace core

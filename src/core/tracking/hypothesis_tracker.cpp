@@ -59,6 +59,7 @@ LocalSolveSettings HypothesisTracker::solveSettings(int k) const
   s.agreement_tolerance = options_.agreement_tolerance;
   s.range_tolerance = options_.range_tolerance;
   s.max_seeds = options_.max_seeds;
+  s.direction_group = options_.direction_group;
   return s;
 }
 
@@ -85,7 +86,9 @@ void HypothesisTracker::accumulateMotion(const Pose2& reference)
     {
       h.travelled += std::hypot(d.x, d.y);
       h.turned += std::abs(d.theta);
-      h.covariance = predictCovariance(h.covariance, compose(h.map_to_odom, last_reference_), d, noise);
+      const Pose2 base = compose(h.map_to_odom, last_reference_);
+      h.covariance = predictCovariance(h.covariance, base, d, noise);
+      h.robust_covariance = predictCovariance(h.robust_covariance, base, d, noise);
     }
   }
   last_reference_ = reference;
@@ -115,6 +118,7 @@ void HypothesisTracker::seed(const std::vector<Candidate>& candidates, const Pos
     h.support = support;
     h.last_fix = c;
     h.covariance = initialCovariance(c);
+    h.robust_covariance = h.covariance;
     hypotheses_.push_back(std::move(h));
   }
   if (!candidates.empty())
@@ -209,9 +213,13 @@ bool HypothesisTracker::updateOne(Hypothesis& h, const std::vector<Reading>& rea
     }
   }
   const Candidate& fix = found.fixes[chosen];
-  const FusedPose fused = fusePose(predicted, h.covariance, fix.pose, options_.fix_covariance_scale * fix.covariance);
+  const double scale = options_.fix_covariance_scale;
+  const FusedPose fused = fusePose(predicted, h.covariance, fix.pose, scale * fix.covariance);
   h.map_to_odom = compose(fused.pose, inverse(reference));
   h.covariance = fused.covariance;
+  h.robust_covariance =
+      fusePose(predicted, h.robust_covariance, fix.pose, scale * (fix.covariance + found.direction_loss[chosen]))
+          .covariance;
   h.travelled = 0.0;
   h.turned = 0.0;
   h.misses = 0;
@@ -273,8 +281,8 @@ const Hypothesis* HypothesisTracker::clearlySupported() const
   const double second = hypotheses_.size() > 1 ? hypotheses_[1].support : 0.0;
   const bool clear = best.misses <= options_.tolerated_misses && !best.conflicted &&
                      best.support >= options_.min_support && best.support - second >= options_.support_margin &&
-                     positionSigma3(best.covariance) <= options_.publish_max_xy &&
-                     headingSigma3(best.covariance) <= options_.publish_max_theta;
+                     positionSigma3(best.robust_covariance) <= options_.publish_max_xy &&
+                     headingSigma3(best.robust_covariance) <= options_.publish_max_theta;
   return clear ? &best : nullptr;
 }
 

@@ -123,9 +123,15 @@ LocalSolveOutcome localSolve(const MapRayCaster& map, const BoxOccupancy& occupa
   // A fix at the end of a continuum of exact poses (a corridor's axis, a heading the readings
   // barely see) must not claim the polish's local precision: the tracker fuses it with the
   // prediction by these covariances.
+  // A person in front of the one sensor fixing a direction moves the fix with every reading
+  // explained: what the fix keeps without any one direction's readings, for the publishing rule.
   for (Candidate& fix : outcome.fixes)
   {
     widenAlongContinua(map, readings, refine.noise_sigma, fix);
+    outcome.direction_loss.push_back(settings.direction_group < 0.0 ?
+                                         Eigen::Matrix3d::Zero() :
+                                         oneDirectionLostCovariance(map, fix.pose, readings, fix.inlier_mask,
+                                                                    refine.noise_sigma, settings.direction_group));
   }
   return outcome;
 }

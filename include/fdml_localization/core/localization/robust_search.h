@@ -70,6 +70,24 @@ struct PolishOutcome
 PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std::vector<Reading>& readings,
                          const std::vector<bool>& use, double robust_scale, int max_iterations, double noise_sigma);
 
+/**
+ * @brief What the covariance of @p pose (from the finite readings selected by @p use, as
+ *        polishPose() computes it) gains when the readings of one direction are all wrong: a
+ *        person in front of one sensor, or hiding a sector of a scanner, shifts every reading
+ *        the robot takes that way alike, and a pose that only those readings fix (the position
+ *        along a corridor from the one sensor seeing its end wall) then moves with them while
+ *        explaining every reading. Groups: the readings whose mounting headings lie within
+ *        @p group_angle [rad] of one reading's. With W the covariance left without the group
+ *        whose loss leaves the largest (determinant) and C that of every reading, returns the
+ *        positive part of W / 2 - C: zero where every direction is fixed by two groups alike
+ *        (without either the covariance doubles), about W where one group fixes a direction
+ *        alone. Positive semi-definite.
+ * @param noise_sigma lower bound on the residual standard deviation [m], as in polishPose()
+ */
+Eigen::Matrix3d oneDirectionLostCovariance(const MapRayCaster& map, const Pose2& pose,
+                                           const std::vector<Reading>& readings, const std::vector<bool>& use,
+                                           double noise_sigma, double group_angle);
+
 /// Settings of refineSeed().
 struct RefinementSettings
 {

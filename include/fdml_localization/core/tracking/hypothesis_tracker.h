@@ -12,8 +12,9 @@
  * Poses: the readings of an update are relative to the base at the odometry pose `reference`
  * (the node's batches: the base at the first reading); a hypothesis's pose of the base at any
  * odometry pose o is map_to_odom (+) o. Each hypothesis also carries the covariance of that pose
- * (pose_filter.h: odometry steps spread it, fixes shrink it); it is published only while that
- * covariance is within the publishing margins (publish_max_xy, publish_max_theta).
+ * (pose_filter.h: odometry steps spread it, fixes shrink it), and a robust covariance counting
+ * of each fix only what no one direction's readings fix alone; it is published only while the
+ * robust one is within the publishing margins (publish_max_xy, publish_max_theta).
  */
 #pragma once
 
@@ -79,6 +80,10 @@ struct TrackerOptions
   double agreement_tolerance = 0.05;  ///< eps [m] (the node takes the localizer's)
   double range_tolerance = 0.02;      ///< tau [m] (the node takes the localizer's)
   int max_seeds = 3;                  ///< leaves refined per local solve
+  /// A fix counts only the precision it keeps when the readings of any one direction (mounting
+  /// headings within this [rad] of each other: one sensor, a sector of a scanner) are wrong, as
+  /// when a person walks in front of that sensor; [0, pi], < 0 = off (LocalSolveSettings).
+  double direction_group = 0.25;
   /// Each fix's covariance is multiplied by this before it is fused, in [1, 1000]. Batches that
   /// slide by s of their k readings share k - s readings with the previous one, so their fixes
   /// are not independent: a filter taking each as new evidence would count every reading k / s
@@ -101,8 +106,12 @@ struct Hypothesis
   double support = 0.0;     ///< decayed sum of net consensus / k
   int misses = 0;           ///< updates in a row without a fix
   bool conflicted = false;  ///< the last update was a miss in conflict (TrackerOptions::conflict_readings)
-  /// Of the base's pose map_to_odom (+) the tracker's last reference (x, y, theta) [m^2, rad^2]
+  /// Of the base's pose map_to_odom (+) the tracker's last reference (x, y, theta) [m^2, rad^2]:
+  /// the filter's, from every reading (the pose and its search box follow it)
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  /// The same pose's covariance counting of each fix only what no one direction's readings fix
+  /// alone (LocalSolveOutcome::direction_loss): the publishing rule's, and the one published.
+  Eigen::Matrix3d robust_covariance = Eigen::Matrix3d::Zero();
   int fixes = 0;       ///< updates with a fix
   Candidate last_fix;  ///< the last fix (pose of the base at its update's reference)
 };

@@ -27,6 +27,9 @@ struct LocalSolveSettings
   double range_tolerance = 0.02;      ///< tau [m] (the box test's noise band)
   int max_seeds = 3;                  ///< distinct leaves refined (besides the box's centre)
   long max_boxes = 200000;            ///< box budget of the search
+  /// Readings whose mounting headings lie within this [rad] count as one direction
+  /// (LocalSolveOutcome::direction_loss). < 0 = no loss computed (zero).
+  double direction_group = 0.25;
 };
 
 /// The outcome of localSolve().
@@ -35,6 +38,9 @@ struct LocalSolveOutcome
   /// Refined poses inside the box (inflated by one leaf) with net consensus >= k', best first
   /// (ranking.h), duplicates (within 2 leaves) removed. Empty: the box holds no fix.
   std::vector<Candidate> fixes;
+  /// For each fix, what its covariance gains when the readings of one direction are all wrong
+  /// (oneDirectionLostCovariance(), robust_search.h) [m^2, rad^2].
+  std::vector<Eigen::Matrix3d> direction_loss;
   /// The largest number of readings any leaf of the box may explain (0 when the search pruned
   /// every box at k'): an upper bound of the consensus inside the box when the search was not
   /// truncated.

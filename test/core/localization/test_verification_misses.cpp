@@ -87,6 +87,10 @@ const char* const kPastMisses[] = {
   "grazing map 0 k 4 exact truth (0.5236786662, 1.0176473813, 0.1665339564)",
   // verify --seed 2: the polish slid along the undetermined x into a no-return contradiction.
   "no-return map 1 k 28 exact truth (6.7708527589, 0.7193026750, -0.3401270461) max range 1.133342685",
+  // verify --seed 3, adaptive: every box passed every no-return reading, so plateaus spanned the
+  // room and its seeds contradicted a no-return reading the truth agrees with.
+  "no-return map 1 k 25 exact truth (4.8689739243, 2.2200645787, 2.7839633264) max range 1.256272970",
+  "no-return map 1 k 26 exact truth (0.7528757131, 3.3276463817, -2.7587847130) max range 2.104833943",
 };
 
 class PastMisses : public ::testing::TestWithParam<Engine>

@@ -21,6 +21,12 @@ namespace core
 {
 namespace
 {
+/// Leaves at the bound (spread over them) whose lattice searchNoReturnRegion() verifies.
+constexpr std::size_t kNoReturnScanLeaves = 512;
+/// Lattice points per axis inside each such leaf.
+constexpr int kNoReturnLattice = 3;
+/// The best lattice poses (one per leaf) refined.
+constexpr std::size_t kNoReturnRefined = 4;
 /// Leaves of a plateau (spread over it) the final multi-start polishes from.
 constexpr std::size_t kRegionStarts = 12;
 /// Distinct seeds taken from one plateau.
@@ -143,6 +149,42 @@ private:
   StageTimes& times_;
   bool truncated_ = false;
 };
+
+/// The best-verified pose of a lattice in each leaf reaching @p bound (at most
+/// kNoReturnScanLeaves leaves, spread over them).
+std::vector<Candidate> leafLatticeBests(const MapRayCaster& map, const std::vector<LeafBox>& leaves, int bound,
+                                        const std::vector<Reading>& readings, double eps)
+{
+  std::vector<const LeafBox*> at_bound;
+  for (const LeafBox& leaf : leaves)
+  {
+    if (leaf.count >= bound)
+    {
+      at_bound.push_back(&leaf);
+    }
+  }
+  const std::size_t step = std::max<std::size_t>(1, at_bound.size() / kNoReturnScanLeaves);
+  std::vector<Candidate> lattice_best;
+  for (std::size_t l = 0; l < at_bound.size(); l += step)
+  {
+    const PoseBox& b = at_bound[l]->box;
+    Candidate leaf_best;
+    leaf_best.inliers = -1;
+    for (int i = 0; i < kNoReturnLattice * kNoReturnLattice * kNoReturnLattice; ++i)
+    {
+      const auto at = [](double lo, double hi, int j) { return lo + (hi - lo) * (j + 0.5) / kNoReturnLattice; };
+      const Pose2 pose(at(b.x0, b.x1, i % kNoReturnLattice), at(b.y0, b.y1, (i / kNoReturnLattice) % kNoReturnLattice),
+                       at(b.t0, b.t1, i / (kNoReturnLattice * kNoReturnLattice)));
+      Candidate c = verifiedCandidate(map, pose, readings, eps);
+      if (leaf_best.inliers < 0 || betterCandidate(c, leaf_best))
+      {
+        leaf_best = std::move(c);
+      }
+    }
+    lattice_best.push_back(std::move(leaf_best));
+  }
+  return lattice_best;
+}
 }  // namespace
 
 Result AdaptiveEngine::localize(const std::vector<Reading>& readings)
@@ -218,6 +260,51 @@ void AdaptiveEngine::localizeRobust(AdaptiveSearch& search, const std::vector<Re
   SeedSearchOutcome found = robustSearch(seeds, *map_, readings, options_, scale, result.times);
   result.min_inliers_used = found.min_inliers_used;
   result.candidates = std::move(found.candidates);
+  searchNoReturnRegion(search, readings, result);
+}
+
+void AdaptiveEngine::searchNoReturnRegion(const AdaptiveSearch& search, const std::vector<Reading>& readings,
+                                          Result& result) const
+{
+  if (result.candidates.empty())
+  {
+    return;
+  }
+  const Candidate& best = result.candidates.front();
+  const int bound = search.consensusBound();
+  const bool no_returns =
+      std::any_of(readings.begin(), readings.end(), [](const Reading& r) { return !std::isfinite(r.range); });
+  if (!no_returns || netConsensus(best) >= bound)
+  {
+    return;
+  }
+  std::vector<Candidate> lattice_best =
+      leafLatticeBests(*map_, search.result().leaves, bound, readings, options_.agreement_tolerance);
+  const std::size_t refined = std::min(kNoReturnRefined, lattice_best.size());
+  std::partial_sort(lattice_best.begin(), lattice_best.begin() + static_cast<std::ptrdiff_t>(refined),
+                    lattice_best.end(), betterCandidate);
+  RefinementSettings settings;
+  settings.agreement_tolerance = options_.agreement_tolerance;
+  settings.robust_scale = std::max(options_.agreement_tolerance, cell_xy_);
+  settings.seed_position_error = cell_xy_;
+  settings.seed_angle_error = cell_theta_;
+  Candidate found = best;
+  for (std::size_t i = 0; i < refined; ++i)
+  {
+    const Candidate& start = lattice_best[i];
+    Candidate c = refineSeed(*map_, start.pose, readings, start.inlier_mask, settings);
+    Candidate& better = betterCandidate(c, start) ? c : lattice_best[i];
+    if (netConsensus(better) > netConsensus(found))
+    {
+      found = better;
+    }
+  }
+  if (netConsensus(found) > netConsensus(best))
+  {
+    result.candidates.insert(result.candidates.begin(), std::move(found));
+    result.candidates = rankAndDeduplicate(std::move(result.candidates), options_.uniqueness_distance,
+                                           options_.uniqueness_angle, options_.max_candidates);
+  }
 }
 
 AdaptiveEngine::AdaptiveEngine(std::shared_ptr<const MapRayCaster> map, const LocalizerOptions& options)

@@ -23,6 +23,57 @@ Box2 sweep(const Box2& positions, const Box2& arc, double inflate)
   return out;
 }
 
+double cross(const Vec2& a, const Vec2& b)
+{
+  return a.x() * b.y() - a.y() * b.x();
+}
+
+/**
+ * True when one map edge stops every ray from every point of @p sensors in every heading of
+ * [a0, a1] [rad] nearer than @p reach [m]: the edge the centre's middle ray hits, with every
+ * corner of @p sensors strictly on the same side of its line, seeing both extreme headings
+ * within the edge's angular span, and at most @p reach from both its ends. Over a box, the
+ * direction to a fixed point is extreme at a corner (it turns monotonically along each side)
+ * and so is the distance to it; a ray that meets another edge first stops even nearer.
+ */
+bool oneEdgeStopsEveryRay(const MapRayCaster& map, const Box2& sensors, double a0, double a1, double reach)
+{
+  if (!(a1 - a0 < kPi) || !(reach > 0.0))
+  {
+    return false;
+  }
+  const double mid = 0.5 * (a0 + a1);
+  const RayHit hit = map.cast(0.5 * (sensors.min + sensors.max), Vec2(std::cos(mid), std::sin(mid)));
+  if (!hit.hit() || !(hit.distance < reach))
+  {
+    return false;
+  }
+  const Segment& edge = map.grid().segments()[static_cast<std::size_t>(hit.segment)];
+  const Vec2 u0(std::cos(a0), std::sin(a0));
+  const Vec2 u1(std::cos(a1), std::sin(a1));
+  const Vec2 corners[4] = { sensors.min, Vec2(sensors.max.x(), sensors.min.y()), sensors.max,
+                            Vec2(sensors.min.x(), sensors.max.y()) };
+  int side = 0;
+  for (const Vec2& c : corners)
+  {
+    const Vec2 da = edge.a - c;
+    const Vec2 db = edge.b - c;
+    const double turn = cross(da, db);
+    const int s = turn > 1e-12 ? 1 : (turn < -1e-12 ? -1 : 0);
+    if (s == 0 || (side != 0 && s != side) || std::max(da.norm(), db.norm()) >= reach)
+    {
+      return false;
+    }
+    side = s;
+    const Vec2& first = s > 0 ? da : db;  // the span runs counterclockwise from first to last
+    const Vec2& last = s > 0 ? db : da;
+    if (cross(first, u0) < 0.0 || cross(u0, last) < 0.0 || cross(first, u1) < 0.0 || cross(u1, last) < 0.0)
+    {
+      return false;
+    }
+  }
+  return true;
+}
 }  // namespace
 
 Box2 rotatedArcBounds(const Vec2& v, double t0, double t1)
@@ -83,7 +134,10 @@ bool readingMayExplain(const MapRayCaster& map, const Reading& reading, const Po
   }
   if (!std::isfinite(reading.range))
   {
-    return true;  // a no-return reading is only checked exactly, in verification
+    // A no-return reading agrees when nothing is nearer than max_range - tau (a cone's nearest
+    // point is no farther than its axis's hit, so the axis decides for a cone too).
+    const Box2 sensors = sweep(positions, rotatedArcBounds(Vec2(g.x, g.y), box.t0, box.t1), 0.0);
+    return !oneEdgeStopsEveryRay(map, sensors, box.t0 + g.theta, box.t1 + g.theta, reading.max_range - range_tolerance);
   }
   return map.grid().anySegmentInBox(sweep(positions, hitArcBounds(reading, box.t0, box.t1), range_tolerance));
 }

@@ -101,6 +101,51 @@ TEST(ReadingMayExplain, NeverRejectsABoxHoldingTheTruth)
   }
 }
 
+TEST(ReadingMayExplain, NoReturnBoxTestIsConservativeAndPrunes)
+{
+  // A no-return reading (max range m) agrees at q when nothing is nearer than m - tau: a box
+  // holding such a pose is never rejected; a box every pose of which sees a wall well within
+  // m is rejected often (the test must prune, not only pass).
+  const auto map = test::loadMap("maps/office.poly");
+  const double tau = 0.02;
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> size(0.001, 0.5), frac(0.0, 1.0), off(-0.3, 0.3), reach(0.3, 4.0);
+  int blocked_boxes = 0, rejected = 0;
+  for (int trial = 0; trial < 20000; ++trial)
+  {
+    const Pose2 q = anyFreePose(*map, rng);
+    Reading r;
+    r.offset = Pose2(off(rng), off(rng), wrapAngle(8.0 * off(rng)));
+    r.range = kInf;
+    r.max_range = reach(rng);
+    const Pose2 sensor = compose(q, r.offset);
+    if (!map->isFree(sensor.position()))
+    {
+      continue;
+    }
+    const double sx = size(rng), sy = size(rng), st = 0.5 * size(rng);
+    PoseBox box;
+    box.x0 = q.x - sx * frac(rng);
+    box.x1 = box.x0 + sx;
+    box.y0 = q.y - sy * frac(rng);
+    box.y1 = box.y0 + sy;
+    box.t0 = q.theta - st * frac(rng);
+    box.t1 = box.t0 + st;
+    const bool may = readingMayExplain(*map, r, box, tau);
+    if (map->range(sensor) >= r.max_range - tau)
+    {
+      ASSERT_TRUE(may) << "trial " << trial;
+    }
+    else if (map->range(sensor) + sx + sy + 4.0 * st < 0.5 * r.max_range)
+    {
+      ++blocked_boxes;
+      rejected += may ? 0 : 1;
+    }
+  }
+  EXPECT_GT(blocked_boxes, 1000);
+  EXPECT_GT(rejected, blocked_boxes / 4) << rejected << " of " << blocked_boxes;
+}
+
 TEST(BoxOccupancy, NoIsNeverWrong)
 {
   BuildingOptions building;

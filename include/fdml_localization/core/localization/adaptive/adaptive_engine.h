@@ -40,6 +40,11 @@ private:
   void localizeRobust(AdaptiveSearch& search, const std::vector<Reading>& readings, Result& result);
   /// The paper's and the baseline's semantics: one k', verified component centres.
   void localizeFixed(AdaptiveSearch& search, const std::vector<Reading>& readings, int level, Result& result);
+  /// Where the readings hold a no-return one and the best candidate explains fewer readings than
+  /// the search's bound: a lattice of poses in the leaves at the bound verified exactly, the best
+  /// added when it beats the best candidate. The polish moves poses by finite ranges only, so a
+  /// region that no-return readings shape is searched rather than polished.
+  void searchNoReturnRegion(const AdaptiveSearch& search, const std::vector<Reading>& readings, Result& result) const;
 
   std::shared_ptr<const MapRayCaster> map_;
   LocalizerOptions options_;

@@ -17,15 +17,7 @@ class Verification : public ::testing::TestWithParam<Engine>
 TEST_P(Verification, RandomTrialsNeverMissTheTruthNorContradictACertificate)
 {
   const auto maps = verification::smallMaps();
-  std::vector<std::unique_ptr<Localizer>> localizers;
-  for (const auto& map : maps)
-  {
-    LocalizerOptions options;
-    options.engine = GetParam();
-    options.resolution = 64;
-    options.threads = 1;
-    localizers.push_back(std::make_unique<Localizer>(map, options));
-  }
+  const std::vector<std::unique_ptr<Localizer>> localizers = verification::smallMapLocalizers(GetParam());
   std::mt19937_64 rng(1600);
   verification::Figures figures;
   for (int t = 0; t < 40; ++t)

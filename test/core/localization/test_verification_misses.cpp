@@ -99,15 +99,7 @@ class PastMisses : public ::testing::TestWithParam<Engine>
 TEST_P(PastMisses, TheTruthIsAmongTheCandidates)
 {
   const auto maps = verification::smallMaps();
-  std::vector<std::unique_ptr<Localizer>> localizers;
-  for (const auto& map : maps)
-  {
-    LocalizerOptions options;
-    options.engine = GetParam();
-    options.resolution = 64;
-    options.threads = 1;
-    localizers.push_back(std::make_unique<Localizer>(map, options));
-  }
+  const std::vector<std::unique_ptr<Localizer>> localizers = verification::smallMapLocalizers(GetParam());
   for (const char* label : kPastMisses)
   {
     const verification::Trial trial = trialFrom(label, maps);

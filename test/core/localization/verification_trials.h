@@ -61,6 +61,21 @@ inline std::vector<std::shared_ptr<const MapRayCaster>> smallMaps()
   return { test::loadMap("maps/l_room.poly"), test::lRoomMap(), test::loadMap("maps/square_room.poly") };
 }
 
+/// One single-thread localizer of @p engine at resolution 64 per map of smallMaps().
+inline std::vector<std::unique_ptr<Localizer>> smallMapLocalizers(Engine engine)
+{
+  std::vector<std::unique_ptr<Localizer>> localizers;
+  for (const auto& map : smallMaps())
+  {
+    LocalizerOptions options;
+    options.engine = engine;
+    options.resolution = 64;
+    options.threads = 1;
+    localizers.push_back(std::make_unique<Localizer>(map, options));
+  }
+  return localizers;
+}
+
 inline std::vector<Pose2> trialOffsets(int geometry, int k, std::mt19937_64& rng)
 {
   std::uniform_real_distribution<double> angle(-kPi, kPi);

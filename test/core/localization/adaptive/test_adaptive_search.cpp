@@ -41,6 +41,20 @@ std::vector<Reading> turnInPlace(const MapRayCaster& map, const Pose2& q, int k,
   return readings;
 }
 
+/// A box of size @p sx x @p sy x @p st [m, m, rad] holding @p q at a random place in it.
+PoseBox boxHolding(const Pose2& q, double sx, double sy, double st, std::mt19937_64& rng)
+{
+  std::uniform_real_distribution<double> frac(0.0, 1.0);
+  PoseBox box;
+  box.x0 = q.x - sx * frac(rng);
+  box.x1 = box.x0 + sx;
+  box.y0 = q.y - sy * frac(rng);
+  box.y1 = box.y0 + sy;
+  box.t0 = q.theta - st * frac(rng);
+  box.t1 = box.t0 + st;
+  return box;
+}
+
 bool keepsTruth(const AdaptiveSearchResult& result, const Pose2& q)
 {
   return test::truthInLeaves(result.leaves, q, 0);
@@ -78,7 +92,7 @@ TEST(ReadingMayExplain, NeverRejectsABoxHoldingTheTruth)
 {
   const auto map = test::loadMap("maps/office.poly");
   std::mt19937_64 rng(12);
-  std::uniform_real_distribution<double> size(0.001, 2.0), frac(0.0, 1.0), off(-0.3, 0.3);
+  std::uniform_real_distribution<double> size(0.001, 2.0), off(-0.3, 0.3);
   for (int trial = 0; trial < 20000; ++trial)
   {
     const Pose2 q = anyFreePose(*map, rng);
@@ -90,13 +104,7 @@ TEST(ReadingMayExplain, NeverRejectsABoxHoldingTheTruth)
     }
     r.range = map->range(compose(q, r.offset));
     const double sx = size(rng), sy = size(rng), st = 2.0 * size(rng);
-    PoseBox box;
-    box.x0 = q.x - sx * frac(rng);
-    box.x1 = box.x0 + sx;
-    box.y0 = q.y - sy * frac(rng);
-    box.y1 = box.y0 + sy;
-    box.t0 = q.theta - st * frac(rng);
-    box.t1 = box.t0 + st;
+    const PoseBox box = boxHolding(q, sx, sy, st, rng);
     ASSERT_TRUE(readingMayExplain(*map, r, box, 0.0)) << "trial " << trial;
   }
 }
@@ -109,7 +117,7 @@ TEST(ReadingMayExplain, NoReturnBoxTestIsConservativeAndPrunes)
   const auto map = test::loadMap("maps/office.poly");
   const double tau = 0.02;
   std::mt19937_64 rng(13);
-  std::uniform_real_distribution<double> size(0.001, 0.5), frac(0.0, 1.0), off(-0.3, 0.3), reach(0.3, 4.0);
+  std::uniform_real_distribution<double> size(0.001, 0.5), off(-0.3, 0.3), reach(0.3, 4.0);
   int blocked_boxes = 0, rejected = 0;
   for (int trial = 0; trial < 20000; ++trial)
   {
@@ -124,13 +132,7 @@ TEST(ReadingMayExplain, NoReturnBoxTestIsConservativeAndPrunes)
       continue;
     }
     const double sx = size(rng), sy = size(rng), st = 0.5 * size(rng);
-    PoseBox box;
-    box.x0 = q.x - sx * frac(rng);
-    box.x1 = box.x0 + sx;
-    box.y0 = q.y - sy * frac(rng);
-    box.y1 = box.y0 + sy;
-    box.t0 = q.theta - st * frac(rng);
-    box.t1 = box.t0 + st;
+    const PoseBox box = boxHolding(q, sx, sy, st, rng);
     const bool may = readingMayExplain(*map, r, box, tau);
     if (map->range(sensor) >= r.max_range - tau)
     {

@@ -118,6 +118,13 @@ struct System
   int used = 0;
 };
 
+/// One reading's row: the cone cast for a cone reading (updating @p hint), else the ray cast.
+ResidualRow readingRow(const MapRayCaster& map, const Pose2& q, const Rotation& rq, const Reading& reading,
+                       const Rotation& mount, Vec2& hint)
+{
+  return reading.half_angle > 0.0 ? coneRow(map, q, rq, reading, hint) : rayRow(map, q, rq, reading, mount);
+}
+
 /// The normal equations at @p q; @p hints: each cone reading's last hit point (see coneRow).
 System buildSystem(const MapRayCaster& map, const Pose2& q, const std::vector<Reading>& readings,
                    const std::vector<Rotation>& mounts, const std::vector<bool>& use, double scale,
@@ -131,8 +138,7 @@ System buildSystem(const MapRayCaster& map, const Pose2& q, const std::vector<Re
     {
       continue;
     }
-    const ResidualRow row = readings[i].half_angle > 0.0 ? coneRow(map, q, rq, readings[i], hints[i]) :
-                                                           rayRow(map, q, rq, readings[i], mounts[i]);
+    const ResidualRow row = readingRow(map, q, rq, readings[i], mounts[i], hints[i]);
     ++sys.used;
     if (!row.valid)
     {
@@ -236,26 +242,34 @@ Eigen::Matrix3d oneDirectionLostCovariance(const MapRayCaster& map, const Pose2&
                                            const std::vector<Reading>& readings, const std::vector<bool>& use,
                                            double noise_sigma, double group_angle)
 {
-  // Each reading's own row of the normal equations (one cast each), then sums over subsets.
-  std::vector<System> rows(readings.size());
+  // Each used reading's own J^T J (one cast each), then sums over subsets; the accounting of
+  // buildSystem() without the robust loss.
+  std::vector<Eigen::Matrix3d> jtj(readings.size(), Eigen::Matrix3d::Zero());
+  std::vector<char> used(readings.size(), 0);
   System all;
+  const Rotation rq(pose.theta);
   for (std::size_t i = 0; i < readings.size(); ++i)
   {
-    std::vector<bool> only(readings.size(), false);
-    only[i] = use[i];
-    std::vector<Rotation> mounts(readings.size(), Rotation(0.0));
-    mounts[i] = Rotation(readings[i].offset.theta);
-    std::vector<Vec2> hints(readings.size(), Vec2::Constant(std::numeric_limits<double>::quiet_NaN()));
-    rows[i] = buildSystem(map, pose, readings, mounts, only, 0.0, hints);
-    all.jtj += rows[i].jtj;
-    all.sum_sq += rows[i].sum_sq;
-    all.used += rows[i].used;
+    if (!use[i] || !std::isfinite(readings[i].range))
+    {
+      continue;
+    }
+    Vec2 hint = Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
+    const ResidualRow row = readingRow(map, pose, rq, readings[i], Rotation(readings[i].offset.theta), hint);
+    used[i] = 1;
+    ++all.used;
+    if (row.valid)
+    {
+      jtj[i] = row.jacobian.transpose() * row.jacobian;
+      all.jtj += jtj[i];
+      all.sum_sq += row.r * row.r;
+    }
   }
   const Eigen::Matrix3d with_all = poseCovariance(map, all, noise_sigma);
   Eigen::Matrix3d worst = with_all;
   for (std::size_t i = 0; i < readings.size(); ++i)
   {
-    if (rows[i].used == 0)
+    if (!used[i])
     {
       continue;
     }
@@ -264,7 +278,7 @@ Eigen::Matrix3d oneDirectionLostCovariance(const MapRayCaster& map, const Pose2&
     {
       if (std::abs(angleDiff(readings[j].offset.theta, readings[i].offset.theta)) <= group_angle)
       {
-        rest.jtj -= rows[j].jtj;
+        rest.jtj -= jtj[j];
       }
     }
     const Eigen::Matrix3d without = poseCovariance(map, rest, noise_sigma);

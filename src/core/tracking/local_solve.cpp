@@ -122,9 +122,9 @@ LocalSolveOutcome localSolve(const MapRayCaster& map, const BoxOccupancy& occupa
       rankAndDeduplicate(std::move(fixes), 2.0 * settings.cell_xy, 2.0 * settings.cell_theta, settings.max_seeds + 1);
   // A fix at the end of a continuum of exact poses (a corridor's axis, a heading the readings
   // barely see) must not claim the polish's local precision: the tracker fuses it with the
-  // prediction by these covariances.
-  // A person in front of the one sensor fixing a direction moves the fix with every reading
-  // explained: what the fix keeps without any one direction's readings, for the publishing rule.
+  // prediction by these covariances. And a person in front of the one sensor fixing a direction
+  // moves the fix with every reading explained: what the fix loses without any one direction's
+  // readings goes to the publishing rule.
   for (Candidate& fix : outcome.fixes)
   {
     widenAlongContinua(map, readings, refine.noise_sigma, fix);

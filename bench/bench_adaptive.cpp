@@ -14,6 +14,8 @@
 // 10 random disc obstacles of radius 0.1 m not covering the sensor; 16 batches, seed 7); auto k'.
 // Engines4of10/...: the same engines on a harder protocol: 4 of the 10 readings cut short (the
 // robustness tests' unknown-obstacle hits), so the consensus is only 6 of 10.
+// Region/<engine>/<with|without>: a search region around the part of a large map the robot
+// drives, against none (see runRegion()).
 // Counters: median_ms (median total per call), success (fraction of calls whose best candidate
 // is within 1 cm and 0.1 degree of the truth), resolution, peak_rss_mb (process peak: run one
 // benchmark per process for a clean figure).
@@ -87,10 +89,11 @@ std::string displayName(const std::string& entry)
 
 /// The paper's protocol (see the file comment); with @p outliers, instead 4 of the 10 exact
 /// readings (random, longer than 0.3 m) are cut short to a random 10 to 80 % and by >= 0.15 m.
-std::vector<Batch> protocolBatches(const core::MapRayCaster& map, int count, bool outliers)
+/// Truths and obstacles are drawn in @p area (empty = the map's bounding box).
+std::vector<Batch> protocolBatches(const core::MapRayCaster& map, int count, bool outliers, core::Box2 area = {})
 {
   std::mt19937_64 rng(7);
-  const core::Box2& b = map.map().bounds();
+  const core::Box2& b = area.empty() ? map.map().bounds() : area;
   std::uniform_real_distribution<double> ux(b.min.x(), b.max.x()), uy(b.min.y(), b.max.y()), ut(-core::kPi, core::kPi);
   auto freePoint = [&]() {
     for (;;)
@@ -200,8 +203,64 @@ void runEngine(benchmark::State& state, const std::string& entry, core::Engine e
   state.counters["peak_rss_mb"] = peakRssMb();
 }
 
+/// Region/<engine>/<with|without>: the defaults (resolution 100) on the 60 x 40 m building
+/// where the robot only drives a 20 x 15 m corner, with and without that corner as the search
+/// region (LocalizerOptions::search_region); truths drawn in the corner.
+void runRegion(benchmark::State& state, core::Engine engine, bool with_region)
+{
+  const auto map = makeMap("building:60x40");
+  const core::Box2& b = map->map().bounds();
+  core::Box2 corner;
+  corner.extend(b.min);
+  corner.extend(b.min + core::Vec2(20.0, 15.0));
+  core::LocalizerOptions options;
+  options.engine = engine;
+  if (with_region)
+  {
+    const core::Ring ring = {
+      corner.min, { corner.max.x(), corner.min.y() }, corner.max, { corner.min.x(), corner.max.y() }
+    };
+    options.search_region = std::make_shared<const core::MapRayCaster>(core::PolygonMap::fromRings({ ring }));
+  }
+  core::Localizer localizer(map, options);
+  const auto start = std::chrono::steady_clock::now();
+  localizer.prepare();
+  state.counters["table_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const std::vector<Batch> batches = protocolBatches(*map, 16, false, corner);
+  std::vector<double> totals;
+  long calls = 0;
+  int success = 0;
+  for (auto _ : state)
+  {
+    const Batch& batch = batches[calls % batches.size()];
+    const core::Result result = localizer.localize(batch.readings);
+    totals.push_back(result.times.total);
+    success +=
+        !result.candidates.empty() &&
+        (result.candidates.front().pose.position() - batch.truth.position()).norm() < 0.05 &&
+        std::abs(core::angleDiff(result.candidates.front().pose.theta, batch.truth.theta)) < 2.0 * core::kPi / 180.0;
+    ++calls;
+  }
+  std::sort(totals.begin(), totals.end());
+  state.counters["median_ms"] = totals.empty() ? 0.0 : 1e3 * totals[totals.size() / 2];
+  state.counters["success"] = static_cast<double>(success) / static_cast<double>(std::max(calls, 1L));
+  state.counters["peak_rss_mb"] = peakRssMb();
+}
+
 int registerAll()
 {
+  for (const core::Engine engine : { core::Engine::Adaptive, core::Engine::Voxel })
+  {
+    for (const bool with_region : { false, true })
+    {
+      const std::string name = std::string("Region/") + core::toString(engine) + (with_region ? "/with" : "/without");
+      benchmark::RegisterBenchmark(name.c_str(),
+                                   [engine, with_region](benchmark::State& s) { runRegion(s, engine, with_region); })
+          ->Iterations(16)
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
+    }
+  }
   std::vector<std::string> entries;
   if (const char* env = std::getenv("FDML_BENCH_ADAPTIVE_MAPS"))
   {

@@ -26,6 +26,7 @@ using core::GridConversionReport;
 using core::gridToPolygon;
 using core::loadPolyFile;
 using core::MapError;
+using core::MapRayCaster;
 using core::MapYaml;
 using core::OccupancyGrid;
 using core::parseMapMode;
@@ -33,6 +34,7 @@ using core::pixelsToGrid;
 using core::PolygonMap;
 using core::Pose2;
 using core::readPolyCellSize;
+using core::Vec2;
 
 namespace
 {
@@ -304,6 +306,17 @@ PolygonMap loadMapFile(const std::string& path, const GridConversionOptions& opt
     *report = file.report;
   }
   return std::move(file.map);
+}
+
+std::shared_ptr<const MapRayCaster> loadSearchRegion(const std::string& path, const Vec2* seed)
+{
+  GridConversionOptions options;
+  if (seed != nullptr)
+  {
+    options.use_seed = true;
+    options.seed_point = *seed;
+  }
+  return std::make_shared<const MapRayCaster>(loadMapFile(path, options));
 }
 
 }  // namespace io

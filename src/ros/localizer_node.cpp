@@ -275,7 +275,7 @@ bool LocalizerNode::globalLocalizationService(std_srvs::Empty::Request& /*req*/,
 
 int runLocalizerNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh)
 {
-  const Params params = loadParams(private_nh);
+  Params params = loadParams(private_nh);
   const std::vector<std::string> errors = validate(params);
   for (const std::string& error : errors)
   {
@@ -288,6 +288,7 @@ int runLocalizerNode(ros::NodeHandle& nh, ros::NodeHandle& private_nh)
   ROS_INFO_STREAM(describe(params));
   try
   {
+    params.search_region_map = loadSearchRegionFile(params.search_region, params.search_region_seed);
     LoadedMap map;
     if (!params.map_file.empty())
     {

@@ -10,16 +10,30 @@
 namespace fdml_localization
 {
 
-std::string resolveMapPath(const std::string& location)
+std::string resolveMapPath(const std::string& location, const std::string& parameter)
 {
   std::string error;
   const std::string path = resolveResourcePath(location, &error);
   if (!error.empty())
   {
-    throw MapLoadError("~map_file \"" + location + "\": " + error);
+    throw MapLoadError(parameter + " \"" + location + "\": " + error);
   }
   return path;
 }
+
+namespace
+{
+/// resolveMapPath(), checked to name a readable file.
+std::string readablePath(const std::string& location, const std::string& parameter)
+{
+  const std::string path = resolveMapPath(location, parameter);
+  if (!std::ifstream(path).good())
+  {
+    throw MapLoadError(parameter + " \"" + location + "\": cannot open \"" + path + "\" (missing or unreadable)");
+  }
+  return path;
+}
+}  // namespace
 
 std::string describeConversion(const core::OccupancyGrid& grid, const core::GridConversionReport& report)
 {
@@ -56,11 +70,7 @@ LoadedMap mapFromGrid(const core::OccupancyGrid& grid, const core::GridConversio
 
 LoadedMap loadMapFromFile(const std::string& location, const core::GridConversionOptions& options)
 {
-  const std::string path = resolveMapPath(location);
-  if (!std::ifstream(path).good())
-  {
-    throw MapLoadError("~map_file \"" + location + "\": cannot open \"" + path + "\" (missing or unreadable)");
-  }
+  const std::string path = readablePath(location, "~map_file");
   try
   {
     io::MapFile file = io::readMapFile(path, options);
@@ -77,6 +87,25 @@ LoadedMap loadMapFromFile(const std::string& location, const core::GridConversio
   catch (const std::exception& error)
   {
     throw MapLoadError(std::string("~map_file: ") + error.what());
+  }
+}
+
+std::shared_ptr<const core::MapRayCaster> loadSearchRegionFile(const std::string& location,
+                                                               const std::vector<double>& seed)
+{
+  if (location.empty())
+  {
+    return nullptr;
+  }
+  const std::string path = readablePath(location, "~search_region");
+  const core::Vec2 point = seed.size() == 2 ? core::Vec2(seed[0], seed[1]) : core::Vec2::Zero();
+  try
+  {
+    return io::loadSearchRegion(path, seed.size() == 2 ? &point : nullptr);
+  }
+  catch (const std::exception& error)
+  {
+    throw MapLoadError(std::string("~search_region: ") + error.what());
   }
 }
 

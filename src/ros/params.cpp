@@ -90,6 +90,25 @@ const char* toString(SolveMode mode)
 
 namespace
 {
+
+/// An optional point parameter: empty, or [x, y] of two finite numbers [m].
+void checkPoint(std::vector<std::string>* errors, const std::string& name, const std::vector<double>& point,
+                const std::string& unset)
+{
+  if (point.empty() || (point.size() == 2 && std::isfinite(point[0]) && std::isfinite(point[1])))
+  {
+    return;
+  }
+  std::ostringstream out;
+  out << "~" << name << " = [";
+  for (std::size_t i = 0; i < point.size(); ++i)
+  {
+    out << (i ? ", " : "") << point[i];
+  }
+  out << "] is out of range; allowed: a list [x, y] of two finite numbers [m] " << unset;
+  errors->push_back(out.str());
+}
+
 void validateMapParams(const Params& p, std::vector<std::string>* errors)
 {
   if (p.map_file.empty() && !p.use_map_topic)
@@ -101,19 +120,12 @@ void validateMapParams(const Params& p, std::vector<std::string>* errors)
         "0 (one cell) or (0, 10] m");
   check(errors, !std::isnan(p.map_min_area) && p.map_min_area <= 1e6, "map_min_area", p.map_min_area,
         "< 0 (ten cells' area) or [0, 1e6] m^2");
-  const bool seed_ok =
-      p.map_seed_point.empty() ||
-      (p.map_seed_point.size() == 2 && std::isfinite(p.map_seed_point[0]) && std::isfinite(p.map_seed_point[1]));
-  if (!seed_ok)
+  checkPoint(errors, "map_seed_point", p.map_seed_point, "(or unset: the largest free region)");
+  checkPoint(errors, "search_region_seed", p.search_region_seed,
+             "(or unset: the largest free region of a grid ~search_region)");
+  if (!p.search_region_seed.empty() && p.search_region.empty())
   {
-    std::ostringstream out;
-    out << "~map_seed_point = [";
-    for (std::size_t i = 0; i < p.map_seed_point.size(); ++i)
-    {
-      out << (i ? ", " : "") << p.map_seed_point[i];
-    }
-    out << "] is out of range; allowed: a list [x, y] of two finite numbers [m] (or unset: the largest free region)";
-    errors->push_back(out.str());
+    errors->push_back("~search_region_seed is set without ~search_region; allowed: only with a ~search_region grid");
   }
   check(errors, p.map_occupied_threshold >= 1 && p.map_occupied_threshold <= 100, "map_occupied_threshold",
         p.map_occupied_threshold, "an integer in [1, 100]");
@@ -154,7 +166,8 @@ void validateFrameParams(const Params& p, std::vector<std::string>* errors)
 
 void validateCoreParams(const Params& p, std::vector<std::string>* errors)
 {
-  check(errors, knownName(p.engine, core::parseEngine), "engine", quoted(p.engine), "\"voxel\" or \"adaptive\"");
+  check(errors, knownName(p.engine, core::parseEngine), "engine", quoted(p.engine),
+        "\"voxel\", \"adaptive\" or \"auto\"");
   check(errors, knownName(p.method, core::parseMethod), "method", quoted(p.method),
         "\"robust\", \"paper\" or \"baseline\"");
   check(errors, knownName(p.no_return, core::parseNoReturn), "no_return", quoted(p.no_return),
@@ -210,6 +223,7 @@ core::LocalizerOptions toLocalizerOptions(const Params& p)
   {
     options.no_return = core::parseNoReturn(p.no_return);
   }
+  options.search_region = p.search_region_map;
   return options;
 }
 
@@ -275,7 +289,8 @@ std::string describe(const Params& p)
       << (p.map_seed_point.size() == 2 ?
               "[" + std::to_string(p.map_seed_point[0]) + ", " + std::to_string(p.map_seed_point[1]) + "]" :
               std::string("(largest free region)"))
-      << ", map_occupied_threshold: " << p.map_occupied_threshold << "\n"
+      << ", map_occupied_threshold: " << p.map_occupied_threshold
+      << ", search_region: " << (p.search_region.empty() ? std::string("(the whole map)") : p.search_region) << "\n"
       << "  measurements_per_batch: " << p.measurements_per_batch << ", batch_stride: " << p.batch_stride
       << ", mode: " << p.mode << ", beams_per_scan: " << p.beams_per_scan << "\n"
       << "  transform_tolerance: " << p.transform_tolerance << " s, relocalize_timeout: " << p.relocalize_timeout

@@ -62,6 +62,8 @@ void readMapParams(ParamReader& r, Params* p)
   r.read("map_min_area", &p->map_min_area);
   r.read("map_seed_point", &p->map_seed_point);
   r.read("map_occupied_threshold", &p->map_occupied_threshold);
+  r.read("search_region", &p->search_region);
+  r.read("search_region_seed", &p->search_region_seed);
 }
 
 void readNodeParams(ParamReader& r, Params* p)

@@ -36,14 +36,20 @@ using UsageError = tools::InputError;
 
 const char* kUsage = "usage: fdml_localize --map MAP.poly|MAP.yaml [--resolution N] [--min-inliers K|auto]\n"
                      "                     [--method robust|paper|baseline] [--range-tolerance T] [--tolerance EPS]\n"
-                     "                     [--threads J] [--engine voxel|adaptive] [--cache-dir DIR]\n"
+                     "                     [--threads J] [--engine voxel|adaptive|auto] [--cache-dir DIR]\n"
                      "                     [--theta-resolution N] [--max-candidates M] [--max-range R] [--verbose]\n"
-                     "                     [--no-return constraint|weak|drop] READINGS.csv\n"
+                     "                     [--no-return constraint|weak|drop] [--region MAP.poly|MAP.yaml]\n"
+                     "                     [--region-seed X,Y] READINGS.csv\n"
+                     "--region: search only where the robot's base may be (the free space of that map file;\n"
+                     "  with --region-seed, of a grid's free region holding that point [m])\n"
                      "READINGS.csv: header gx,gy,gtheta,d[,max_range][,fov] (fov: full field of view [deg])\n";
 
 struct Arguments
 {
   std::string map;
+  std::string region;  ///< --region: a search region's map file
+  bool region_seed = false;
+  core::Vec2 seed = core::Vec2::Zero();  ///< --region-seed [m]
   std::string csv;
   core::LocalizerOptions options;
   double max_range = core::kInf;
@@ -117,6 +123,15 @@ bool applyValueFlag(const std::string& flag, const std::function<std::string()>&
   {
     o.cache_dir = value();
   }
+  else if (flag == "--region")
+  {
+    args.region = value();
+  }
+  else if (flag == "--region-seed")
+  {
+    args.region_seed = true;
+    core::parsePoint(value(), flag, args.seed.x(), args.seed.y());
+  }
   else if (flag == "--max-range")
   {
     args.max_range = core::parseNumber(value(), flag, true);
@@ -174,6 +189,10 @@ Arguments parseArguments(int argc, char** argv)
   if (args.csv.empty())
   {
     throw UsageError("the readings file READINGS.csv is required");
+  }
+  if (args.region_seed && args.region.empty())
+  {
+    throw UsageError("--region-seed needs --region");
   }
   return args;
 }
@@ -246,7 +265,12 @@ int main(int argc, char** argv)
     tools::validateCsvReadings(csv, args.csv, args.options);
     io::MapFile file = io::readMapFile(args.map);
     auto map = std::make_shared<const core::MapRayCaster>(std::move(file.map));
-    core::Localizer localizer(map, core::withGridTolerances(args.options, file.cell_size, args.set));
+    core::LocalizerOptions options = core::withGridTolerances(args.options, file.cell_size, args.set);
+    if (!args.region.empty())
+    {
+      options.search_region = io::loadSearchRegion(args.region, args.region_seed ? &args.seed : nullptr);
+    }
+    core::Localizer localizer(map, options);
     const core::Result result = localizer.localize(csv.readings);
     const std::string cache_warning = core::tableCacheWarning(localizer);
     if (!cache_warning.empty())

@@ -68,15 +68,8 @@ bool applyFlag(const std::string& arg, const std::function<std::string()>& value
   }
   else if (arg == "--seed-point")
   {
-    const std::string text = value();
-    const std::size_t comma = text.find(',');
-    if (comma == std::string::npos)
-    {
-      throw std::invalid_argument("--seed-point: expected X,Y, got '" + text + "'");
-    }
     args.options.use_seed = true;
-    args.options.seed_point =
-        core::Vec2(core::parseNumber(text.substr(0, comma), arg), core::parseNumber(text.substr(comma + 1), arg));
+    core::parsePoint(value(), arg, args.options.seed_point.x(), args.options.seed_point.y());
   }
   else if (arg == "--occupied-threshold")
   {

@@ -52,6 +52,24 @@ TEST(MapLoading, MalformedOrUnknownPackageUrisAreNamed)
   EXPECT_NE(unknown.find("~map_file"), std::string::npos) << unknown;
 }
 
+TEST(MapLoading, SearchRegionsLoadLikeMapsAndNameTheirParameter)
+{
+  EXPECT_EQ(loadSearchRegionFile("", {}), nullptr);
+  const auto region = loadSearchRegionFile(kTestMap, {});
+  ASSERT_TRUE(region);
+  EXPECT_EQ(region->map().bounds().max, loadMap(kTestMap)->map().bounds().max);
+  // A grid region: the free region holding the seed point.
+  const std::string grid = std::string(FDML_SOURCE_DIR) + "/maps/apartment_grid.yaml";
+  const auto largest = loadSearchRegionFile(grid, {});
+  ASSERT_TRUE(largest);
+  EXPECT_GT(largest->map().area(), 10.0);
+  const std::string missing = errorOf([] { loadSearchRegionFile("/nonexistent/fdml/region.poly", {}); });
+  EXPECT_NE(missing.find("~search_region"), std::string::npos) << missing;
+  EXPECT_NE(missing.find("/nonexistent/fdml/region.poly"), std::string::npos) << missing;
+  const std::string wall = errorOf([&grid] { loadSearchRegionFile(grid, { -1000.0, -1000.0 }); });
+  EXPECT_NE(wall.find("~search_region"), std::string::npos) << wall;
+}
+
 TEST(MapLoading, LoadsAPolyFile)
 {
   const auto map = loadMap(kTestMap);

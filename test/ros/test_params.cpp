@@ -44,11 +44,23 @@ TEST(Params, EachOutOfRangeValueNamesItsParameterAndRange)
     { "base_frame_id", [](Params& p) { p.base_frame_id = "base link"; }, "without spaces" },
     { "odom_frame_id", [](Params& p) { p.odom_frame_id = "base_link"; }, "different" },
     { "range_topic", [](Params& p) { p.range_topic = ""; }, "non-empty" },
-    { "engine", [](Params& p) { p.engine = "quantum"; }, "\"voxel\" or \"adaptive\"" },
+    { "engine", [](Params& p) { p.engine = "quantum"; }, "\"voxel\", \"adaptive\" or \"auto\"" },
     { "method", [](Params& p) { p.method = "magic"; }, "\"robust\", \"paper\" or \"baseline\"" },
-    { "resolution", [](Params& p) { p.localizer.resolution = 15; }, "[16, 1024]" },
-    { "resolution", [](Params& p) { p.localizer.resolution = 1025; }, "[16, 1024]" },
-    { "theta_resolution", [](Params& p) { p.localizer.theta_resolution = 15; }, "[16, 1024]" },
+    { "resolution", [](Params& p) { p.localizer.resolution = 15; }, "[16, 100000] for engine adaptive" },
+    { "resolution",
+      [](Params& p) {
+        p.engine = "voxel";
+        p.localizer.resolution = 1025;
+      },
+      "[16, 1024] for engine voxel" },
+    { "resolution",
+      [](Params& p) {
+        p.method = "paper";  // auto: the voxel engine
+        p.localizer.min_inliers = 5;
+        p.localizer.resolution = 1025;
+      },
+      "[16, 1024] for engine voxel" },
+    { "theta_resolution", [](Params& p) { p.localizer.theta_resolution = 15; }, "[16, 100000]" },
     { "min_inliers", [](Params& p) { p.localizer.min_inliers = 2; }, "[3, ~measurements_per_batch]" },
     { "min_inliers", [](Params& p) { p.localizer.min_inliers = 11; }, "[3, ~measurements_per_batch]" },
     { "min_inliers", [](Params& p) { p.method = "paper"; }, "with ~method paper" },
@@ -192,7 +204,10 @@ TEST(Params, RejectsWhatTheCoreRejects)
   // Every core option the core rejects, the node rejects first (naming the parameter).
   std::vector<std::function<void(Params&)>> rejected = {
     [](Params& p) { p.localizer.resolution = 15; },
-    [](Params& p) { p.localizer.resolution = 1025; },
+    [](Params& p) {
+      p.engine = "voxel";
+      p.localizer.resolution = 1025;
+    },
     [](Params& p) {
       p.engine = "adaptive";
       p.localizer.resolution = 100001;

@@ -53,6 +53,17 @@ TEST(Params, GridConversionParametersAreValidated)
         p.map_seed_point = { 1.0, inf };
       },
       "two finite numbers" },
+    { "search_region_seed",
+      [](Params& p) {
+        p.search_region = "region.yaml";
+        p.search_region_seed = { 1.0 };
+      },
+      "two finite numbers" },
+    { "search_region_seed",
+      [](Params& p) {
+        p.search_region_seed = { 1.0, 2.0 };
+      },
+      "only with a ~search_region" },
     { "map_occupied_threshold", [](Params& p) { p.map_occupied_threshold = 0; }, "[1, 100]" },
     { "map_occupied_threshold", [](Params& p) { p.map_occupied_threshold = 101; }, "[1, 100]" },
   };

@@ -94,11 +94,62 @@ TEST(LocalizeMaps, PolyYamlAndConvertedPolyAlikeWithGridTolerances)
   };
   for (const Case& c : cases)
   {
-    const Best best = runLocalize(c.args + " " + csv_path, dir);
+    // The voxel engine: its search goes down from the readings agreeing within the agreement
+    // tolerance, which these counts are about (the adaptive engine proves the consensus within
+    // the smaller range tolerance, 9 here, and may stop at a pose of 9 inliers).
+    const Best best = runLocalize("--engine voxel " + c.args + " " + csv_path, dir);
     EXPECT_EQ(best.status, 0) << c.args;
     EXPECT_LT(test::positionError(best.pose, truth), 0.05) << c.args;
     EXPECT_EQ(best.inliers, c.inliers) << c.args;
   }
+  fs::remove_all(dir);
+}
+
+TEST(LocalizeMaps, ARegionFileBoundsTheSearch)
+{
+  const fs::path dir = fs::temp_directory_path() / ("fdml_localize_region_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  // Rooms [0, 4] x [0, 3] and [6, 10] x [0, 3], joined by a band along y in [3, 3.5]: a pose in
+  // one and its copy 6 m to the right read alike.
+  const Ring outer = { { 0, 0 }, { 4, 0 }, { 4, 3 }, { 6, 3 }, { 6, 0 }, { 10, 0 }, { 10, 3.5 }, { 0, 3.5 } };
+  const MapRayCaster map(PolygonMap::fromRings({ outer }));
+  savePolyFile((dir / "rooms.poly").string(), map.map());
+  const auto rectangle = [](double x0, double x1) {
+    return PolygonMap::fromRings({ Ring{ { x0, 0 }, { x1, 0 }, { x1, 3 }, { x0, 3 } } });
+  };
+  savePolyFile((dir / "left.poly").string(), rectangle(0.0, 4.0));
+  savePolyFile((dir / "right.poly").string(), rectangle(6.0, 10.0));
+  savePolyFile((dir / "away.poly").string(), rectangle(20.0, 24.0));
+  // The right room as a map_server grid region (the free region holding the seed point).
+  io::saveOccupancyGridYaml((dir / "right.yaml").string(), rasterize(rectangle(6.0, 10.0), RasterizeOptions{}));
+  const Pose2 truth(1.5, 1.0, 0.3);
+  const Pose2 twin(7.5, 1.0, 0.3);
+  std::ofstream csv(dir / "r.csv");
+  csv.precision(17);
+  csv << "gx,gy,gtheta,d\n";
+  for (const Reading& r : test::exactReadings(map, truth, test::inPlaceOffsets(8)))
+  {
+    csv << r.offset.x << "," << r.offset.y << "," << r.offset.theta << "," << r.range << "\n";
+  }
+  csv.close();
+  const std::string base = "--map " + (dir / "rooms.poly").string() + " " + (dir / "r.csv").string();
+  for (const char* engine : { "voxel", "adaptive" })
+  {
+    const std::string with = base + " --engine " + engine + " --region ";
+    const Best left = runLocalize(with + (dir / "left.poly").string(), dir);
+    EXPECT_EQ(left.status, 0) << engine;
+    EXPECT_LT(test::positionError(left.pose, truth), 0.05) << engine;
+    for (const std::string& region : { (dir / "right.poly").string(), (dir / "right.yaml").string() + " --region-seed "
+                                                                                                      "8,1" })
+    {
+      const Best right = runLocalize(with + region, dir);
+      EXPECT_EQ(right.status, 0) << engine << " " << region;
+      EXPECT_LT(test::positionError(right.pose, twin), 0.05) << engine << " " << region;
+    }
+    EXPECT_EQ(runLocalize(with + (dir / "away.poly").string(), dir).status, 2) << engine;
+  }
+  EXPECT_EQ(runLocalize(base + " --region-seed 8,1", dir).status, 2);
+  EXPECT_EQ(runLocalize(base + " --region " + (dir / "missing.poly").string(), dir).status, 2);
   fs::remove_all(dir);
 }
 

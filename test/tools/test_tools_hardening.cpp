@@ -46,8 +46,8 @@ protected:
   }
   fdml_localization::test::ToolRun localize(const std::string& args) const
   {
-    return fdml_localization::test::runTool(FDML_LOCALIZE_EXE, "--map " + map_path_ + " --resolution 24 " + args,
-                                            dir_.string());
+    return fdml_localization::test::runTool(
+        FDML_LOCALIZE_EXE, "--map " + map_path_ + " --engine voxel --resolution 24 " + args, dir_.string());
   }
   std::string readingsCsv() const
   {

@@ -9,8 +9,10 @@
 
 #include "fdml_localization/core/map/grid/grid_to_polygon.h"
 #include "fdml_localization/core/map/grid/occupancy_grid.h"
+#include "fdml_localization/core/geometry/ray_caster.h"
 #include "fdml_localization/core/map/polygon_map.h"
 
+#include <memory>
 #include <string>
 
 namespace fdml_localization
@@ -64,6 +66,15 @@ MapFile readMapFile(const std::string& path, const core::GridConversionOptions& 
 /// readMapFile(), the map only (@p report, when not null, receives the conversion's report).
 core::PolygonMap loadMapFile(const std::string& path, const core::GridConversionOptions& options = {},
                              core::GridConversionReport* report = nullptr);
+
+/**
+ * @brief A search region (core::LocalizerOptions::search_region) from any map file, loaded as
+ *        readMapFile() loads maps: the free space of a `.poly`, or of a map_server YAML grid
+ *        (with @p seed [m], the free region holding that point; otherwise the largest). A copy of
+ *        the map's image with everything the robot never reaches painted black makes one.
+ * @throws core::MapError naming the file and the problem
+ */
+std::shared_ptr<const core::MapRayCaster> loadSearchRegion(const std::string& path, const core::Vec2* seed = nullptr);
 
 /**
  * @brief Writes a PNG preview: the grid in grey (free white, occupied black, unknown grey),

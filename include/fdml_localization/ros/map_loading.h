@@ -11,6 +11,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace fdml_localization
 {
@@ -37,9 +38,10 @@ struct LoadedMap
  * @brief Resolves a map location to a file path with resolveResourcePath() (param_utils.h):
  *        "package://PKG/rel/path" through the ROS package path, "file:///abs/path" to
  *        "/abs/path", anything else unchanged.
+ * @param parameter names the location in errors
  * @throws MapLoadError when the package is not found or the URI is malformed.
  */
-std::string resolveMapPath(const std::string& location);
+std::string resolveMapPath(const std::string& location, const std::string& parameter = "~map_file");
 
 /**
  * @brief Loads the map named by @p location (see resolveMapPath()) with io::readMapFile():
@@ -48,6 +50,15 @@ std::string resolveMapPath(const std::string& location);
  *         when known, and the problem.
  */
 LoadedMap loadMapFromFile(const std::string& location, const core::GridConversionOptions& options = {});
+
+/**
+ * @brief The search region named by ~search_region (core::LocalizerOptions::search_region):
+ *        any map file, as for ~map_file; @p seed ([x, y] [m], or empty) picks a grid's free
+ *        region. Null for an empty @p location.
+ * @throws MapLoadError naming ~search_region, the file and the problem
+ */
+std::shared_ptr<const core::MapRayCaster> loadSearchRegionFile(const std::string& location,
+                                                               const std::vector<double>& seed);
 
 /// loadMapFromFile() with the default conversion options, returning the map only.
 std::shared_ptr<const core::MapRayCaster> loadMap(const std::string& location);

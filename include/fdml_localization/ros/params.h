@@ -46,7 +46,14 @@ struct Params
   /// ~map_seed_point [m]: [x, y] in the map frame, keep the free region holding it; empty =
   /// the largest free region. A list of another length is kept here as given (validate() reports it).
   std::vector<double> map_seed_point;
-  int map_occupied_threshold = 50;   ///< ~map_occupied_threshold: cells >= this are walls, [1, 100]
+  int map_occupied_threshold = 50;  ///< ~map_occupied_threshold: cells >= this are walls, [1, 100]
+  /// ~search_region: where the robot's base may be, any map file as for ~map_file (its free
+  /// space); empty = the whole map. Global searches cover only it (LocalizerOptions::search_region).
+  std::string search_region;
+  /// ~search_region_seed [m]: [x, y], a grid ~search_region's free region holding it; empty = the largest.
+  std::vector<double> search_region_seed;
+  /// The region loaded from ~search_region (by runLocalizerNode(), after validation); null = none.
+  std::shared_ptr<const core::MapRayCaster> search_region_map;
   int measurements_per_batch = 10;   ///< ~measurements_per_batch: k, in [3, 255]
   int batch_stride = 1;              ///< ~batch_stride: readings the window slides by, in [1, k]
   std::string mode = "on_request";   ///< ~mode: on_request | continuous
@@ -74,7 +81,7 @@ struct Params
   // Core options: the parameters of the same names (~resolution, ~agreement_tolerance, ...) map
   // onto core::LocalizerOptions, validated once by core::validate(); only the engine and method
   // names are kept as text here, so that an unknown name can be reported.
-  std::string engine = "voxel";          ///< ~engine: voxel | adaptive
+  std::string engine = "auto";           ///< ~engine: voxel | adaptive | auto
   std::string method = "robust";         ///< ~method: robust | paper | baseline
   std::string no_return = "constraint";  ///< ~no_return: constraint | weak | drop (core NoReturnPolicy)
   core::LocalizerOptions localizer;      ///< every other core option (engine, method: see above)

@@ -7,6 +7,7 @@
 
 #include "fdml_localization/core/localization/voxel/voxel_engine.h"
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <sstream>
@@ -52,6 +53,8 @@ const char* toString(Engine engine)
       return "voxel";
     case Engine::Adaptive:
       return "adaptive";
+    case Engine::Auto:
+      return "auto";
   }
   return "unknown";
 }
@@ -83,7 +86,20 @@ Engine parseEngine(const std::string& text)
   {
     return Engine::Adaptive;
   }
-  throw std::invalid_argument("unknown engine '" + text + "' (expected voxel or adaptive)");
+  if (text == "auto")
+  {
+    return Engine::Auto;
+  }
+  throw std::invalid_argument("unknown engine '" + text + "' (expected voxel, adaptive or auto)");
+}
+
+Engine resolveEngine(const LocalizerOptions& options)
+{
+  if (options.engine != Engine::Auto)
+  {
+    return options.engine;
+  }
+  return options.method == Method::Robust ? Engine::Adaptive : Engine::Voxel;
 }
 
 std::vector<std::string> validate(const LocalizerOptions& o, const std::function<std::string(const std::string&)>& name)
@@ -98,8 +114,9 @@ std::vector<std::string> validate(const LocalizerOptions& o, const std::function
   };
   const auto in = [](double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; };
   // The voxel engine holds n x n x n_theta samples; the adaptive engine only the boxes it keeps.
-  const int max_resolution = o.engine == Engine::Voxel ? kMaxVoxelResolution : kMaxAdaptiveResolution;
-  const std::string range = "[16, " + std::to_string(max_resolution) + "] for engine " + toString(o.engine);
+  const Engine engine = resolveEngine(o);
+  const int max_resolution = engine == Engine::Voxel ? kMaxVoxelResolution : kMaxAdaptiveResolution;
+  const std::string range = "[16, " + std::to_string(max_resolution) + "] for engine " + toString(engine);
   check(o.resolution >= 16 && o.resolution <= max_resolution, "resolution", std::to_string(o.resolution),
         "an integer in " + range);
   check(o.theta_resolution == 0 || (o.theta_resolution >= 16 && o.theta_resolution <= max_resolution),
@@ -123,6 +140,8 @@ std::vector<std::string> validate(const LocalizerOptions& o, const std::function
   check(o.no_return == NoReturnPolicy::Constraint || o.no_return == NoReturnPolicy::Weak ||
             o.no_return == NoReturnPolicy::Drop,
         "no_return", std::to_string(static_cast<int>(o.no_return)), "constraint, weak or drop");
+  check(!o.search_region || o.search_region->map().area() > 0.0, "search_region", "a polygon with no area",
+        "a polygon with area, or none (the whole map)");
   return errors;
 }
 
@@ -177,6 +196,44 @@ void validateReadings(const std::vector<Reading>& readings, const LocalizerOptio
   }
 }
 
+Box2 searchBounds(const MapRayCaster& map, const LocalizerOptions& options)
+{
+  Box2 bounds = map.map().bounds();
+  if (options.search_region)
+  {
+    const Box2& region = options.search_region->map().bounds();
+    bounds.min = bounds.min.cwiseMax(region.min);
+    bounds.max = bounds.max.cwiseMin(region.max);
+  }
+  return bounds;
+}
+
+bool inSearchRegion(const LocalizerOptions& options, const Vec2& position)
+{
+  return !options.search_region || options.search_region->isFree(position);
+}
+
+namespace
+{
+/// Drops the candidates whose base lies outside the search region (a polish may move one out
+/// of a box straddling the region's edge); the certificate then vouches for no region.
+void keepInSearchRegion(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
+                        Result& result)
+{
+  std::vector<Candidate>& c = result.candidates;
+  const std::size_t before = c.size();
+  c.erase(std::remove_if(c.begin(), c.end(),
+                         [&](const Candidate& x) { return !inSearchRegion(options, Vec2(x.pose.x, x.pose.y)); }),
+          c.end());
+  if (c.size() != before)
+  {
+    result.certificate.best_consensus =
+        c.empty() ? 0 : consensusWithin(map, c.front().pose, readings, options.range_tolerance);
+    result.certificate.complete = false;
+  }
+}
+}  // namespace
+
 Localizer::Localizer(std::shared_ptr<const MapRayCaster> map, const LocalizerOptions& options)
   : map_(std::move(map)), options_(options)
 {
@@ -194,12 +251,19 @@ Localizer::Localizer(std::shared_ptr<const MapRayCaster> map, const LocalizerOpt
   {
     throw std::invalid_argument("the map has no area");
   }
+  options_.engine = resolveEngine(options_);
+  const Box2 searched = searchBounds(*map_, options_);
+  if (options_.search_region && !(searched.size().minCoeff() > 0.0))
+  {
+    throw std::invalid_argument("the search region does not overlap the map's bounding box");
+  }
   switch (options_.engine)
   {
     case Engine::Voxel:
       engine_ = std::make_unique<VoxelEngine>(map_, options_);
       break;
     case Engine::Adaptive:
+    case Engine::Auto:
       engine_ = std::make_unique<AdaptiveEngine>(map_, options_);
       break;
   }
@@ -226,6 +290,7 @@ Result Localizer::localize(const std::vector<Reading>& readings)
     // drop no-return policies the certificate speaks of the readings with a return.
     certifyVoxels(*map_, searched, options_.range_tolerance, voxel->grid(), voxel->lastCount(), result);
   }
+  keepInSearchRegion(*map_, searched, options_, result);
   if (!all)
   {
     restoreNoReturns(&result, readings, kept, options_, *map_);

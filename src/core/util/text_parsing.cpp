@@ -47,5 +47,16 @@ int parseInteger(const std::string& text, const std::string& what)
   return static_cast<int>(value);
 }
 
+void parsePoint(const std::string& text, const std::string& what, double& x, double& y)
+{
+  const std::size_t comma = text.find(',');
+  if (comma == std::string::npos || text.find(',', comma + 1) != std::string::npos)
+  {
+    throw std::invalid_argument(what + ": expected X,Y, got '" + text + "'");
+  }
+  x = parseNumber(text.substr(0, comma), what);
+  y = parseNumber(text.substr(comma + 1), what);
+}
+
 }  // namespace core
 }  // namespace fdml_localization

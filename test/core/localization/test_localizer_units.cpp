@@ -231,6 +231,7 @@ TEST(LocalizerInput, BadOptionsAreAClearError)
 {
   const auto map = test::lRoomMap();
   LocalizerOptions options;
+  options.engine = Engine::Voxel;
   options.resolution = 24;
   for (int n : { 15, 1025, 0, -3 })
   {
@@ -257,6 +258,20 @@ TEST(LocalizerInput, BadOptionsAreAClearError)
   EXPECT_EQ(validate(adaptive).size(), 1u);
   EXPECT_THROW(Localizer(std::make_shared<const MapRayCaster>(), options), std::invalid_argument);
   EXPECT_TRUE(validate(LocalizerOptions()).empty());
+  // Auto: the adaptive engine's range with the robust method, the voxel engine's with the paper's.
+  LocalizerOptions automatic;
+  automatic.resolution = 5000;
+  EXPECT_EQ(resolveEngine(automatic), Engine::Adaptive);
+  EXPECT_TRUE(validate(automatic).empty());
+  automatic.method = Method::Paper;
+  automatic.min_inliers = 5;
+  EXPECT_EQ(resolveEngine(automatic), Engine::Voxel);
+  ASSERT_EQ(validate(automatic).size(), 1u);
+  EXPECT_NE(validate(automatic)[0].find("for engine voxel"), std::string::npos) << validate(automatic)[0];
+  automatic.resolution = 24;
+  EXPECT_EQ(Localizer(map, automatic).options().engine, Engine::Voxel);  // resolved when built
+  EXPECT_EQ(parseEngine("auto"), Engine::Auto);
+  EXPECT_STREQ(toString(Engine::Auto), "auto");
 }
 
 TEST(LocalizerInput, ParseAndPrintNames)

@@ -47,8 +47,9 @@ enum class Method
 
 enum class Engine
 {
-  Voxel,    ///< uniform n x n x n_theta grid (the paper's voxel clouds)
-  Adaptive  ///< branch and prune over boxes of poses
+  Voxel,     ///< uniform n x n x n_theta grid (the paper's voxel clouds)
+  Adaptive,  ///< branch and prune over boxes of poses
+  Auto       ///< the faster for the job: see resolveEngine()
 };
 
 /// How readings with no return (range = +inf) are used; see no_return.h.
@@ -66,7 +67,7 @@ const char* toString(NoReturnPolicy policy);
 NoReturnPolicy parseNoReturn(const std::string& text);
 /// Parses "robust" / "paper" / "baseline"; throws std::invalid_argument otherwise.
 Method parseMethod(const std::string& text);
-/// Parses "voxel" / "adaptive"; throws std::invalid_argument otherwise.
+/// Parses "voxel" / "adaptive" / "auto"; throws std::invalid_argument otherwise.
 Engine parseEngine(const std::string& text);
 
 /// Largest resolution of the voxel engine (its table holds n x n x n_theta samples).
@@ -80,7 +81,7 @@ constexpr double kMaxAgreementTolerance = 1e6;
 /// Localizer options. validate() lists every out-of-range value.
 struct LocalizerOptions
 {
-  Engine engine = Engine::Voxel;
+  Engine engine = Engine::Auto;  ///< resolved by resolveEngine() when the Localizer is built
   Method method = Method::Robust;
   int resolution = 100;               ///< cells along the map's longer side, in [16, 1024] (voxel)
                                       ///< or [16, 100000] (adaptive)
@@ -101,7 +102,31 @@ struct LocalizerOptions
   double deadline = 0.0;
   /// Readings with no return: constraints (the default), weak evidence, or dropped.
   NoReturnPolicy no_return = NoReturnPolicy::Constraint;
+  /// Where the robot's base may be (its free space; null = anywhere in the map). The search
+  /// covers this region's bounding box cut to the map's (so resolution counts cells along that
+  /// box's longer side) and only poses whose base may lie in the region; candidates outside it
+  /// are dropped. Rays still meet every wall of the map, inside the region or not.
+  std::shared_ptr<const MapRayCaster> search_region;
 };
+
+/**
+ * @brief The engine a Localizer runs: options.engine, or for Engine::Auto the adaptive engine
+ *        with the robust method and the voxel engine with the paper's and the baseline's (their
+ *        semantics are those of the paper's voxel clouds). With the robust method the adaptive
+ *        engine was the faster at every map size measured, from a 2 m room to a 60 x 40 m
+ *        building (2 to 30 times per call at resolution 100, and it builds no table:
+ *        docs/BENCHMARKS.md, "Choosing the engine").
+ */
+Engine resolveEngine(const LocalizerOptions& options);
+
+/**
+ * @brief The box of base positions the search covers [m]: the map's bounding box, cut to the
+ *        search region's when one is set (empty when they do not overlap).
+ */
+Box2 searchBounds(const MapRayCaster& map, const LocalizerOptions& options);
+
+/// True when @p position [m] lies in the search region (always without one).
+bool inSearchRegion(const LocalizerOptions& options, const Vec2& position);
 
 /**
  * @brief The one validation of the options: every problem, each as "NAME = VALUE is out of

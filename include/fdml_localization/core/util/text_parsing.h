@@ -25,5 +25,8 @@ double parseNumber(const std::string& text, const std::string& what, bool allow_
 /// Parses @p text as an integer in [-1e9, 1e9]. @throws std::invalid_argument naming @p what.
 int parseInteger(const std::string& text, const std::string& what);
 
+/// Parses "X,Y" (two finite numbers) into @p x and @p y. @throws std::invalid_argument naming @p what.
+void parsePoint(const std::string& text, const std::string& what, double& x, double& y);
+
 }  // namespace core
 }  // namespace fdml_localization

@@ -310,11 +310,15 @@ void AdaptiveEngine::searchNoReturnRegion(const AdaptiveSearch& search, const st
 AdaptiveEngine::AdaptiveEngine(std::shared_ptr<const MapRayCaster> map, const LocalizerOptions& options)
   : map_(std::move(map)), options_(options)
 {
-  const Vec2 size = map_->map().bounds().size();
+  const Vec2 size = searchBounds(*map_, options_).size();
   cell_xy_ = std::max(size.x(), size.y()) / options_.resolution;
   const int nt = options_.theta_resolution > 0 ? options_.theta_resolution : options_.resolution;
   cell_theta_ = kTwoPi / nt;
   occupancy_ = std::make_shared<const BoxOccupancy>(*map_, cell_xy_, kOccupancyCells);
+  if (options_.search_region)
+  {
+    region_occupancy_ = std::make_shared<const BoxOccupancy>(*options_.search_region, cell_xy_, kOccupancyCells);
+  }
 }
 
 AdaptiveSearchOptions AdaptiveEngine::searchOptions(int min_count) const
@@ -327,6 +331,12 @@ AdaptiveSearchOptions AdaptiveEngine::searchOptions(int min_count) const
   o.max_boxes = options_.max_boxes;
   o.deadline = options_.deadline;
   o.threads = options_.threads;
+  if (region_occupancy_)
+  {
+    const Box2 b = searchBounds(*map_, options_);
+    o.region = PoseBox{ b.min.x(), b.max.x(), b.min.y(), b.max.y(), -kPi, kPi };
+    o.positions = region_occupancy_.get();
+  }
   return o;
 }
 

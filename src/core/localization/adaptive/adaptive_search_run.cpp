@@ -112,7 +112,7 @@ bool AdaptiveSearch::test(Node& n, int level, int min_count) const
   positions.extend(Vec2(b.x1, b.y1));
   n.count = 0;
   n.mask = 0;
-  if (!occupancy_.mayBeFree(positions))
+  if (!occupancy_.mayBeFree(positions) || (options_.positions && !options_.positions->mayBeFree(positions)))
   {
     return false;
   }

@@ -2,6 +2,7 @@
 
 #include "fdml_localization/core/localization/robust_search.h"
 #include "fdml_localization/core/localization/components.h"
+#include "fdml_localization/core/localization/voxel/box_occupancy.h"
 #include "fdml_localization/core/util/stopwatch.h"
 
 #include <omp.h>
@@ -38,6 +39,28 @@ struct ByteSpread
   }
 };
 const ByteSpread kByteSpread;
+
+/// The voxels whose cell may meet @p region, every heading (conservative: a "no" is exact).
+VoxelSet regionMask(const MapRayCaster& region, const GridSpec& spec)
+{
+  const BoxOccupancy occupancy(region, spec.cell);  // a voxel's cell is one query
+  VoxelSet mask(spec);
+  for (int iy = 0; iy < spec.ny; ++iy)
+  {
+    for (int ix = 0; ix < spec.nx; ++ix)
+    {
+      Box2 cell;
+      cell.extend(Vec2(spec.origin_x + ix * spec.cell, spec.origin_y + iy * spec.cell));
+      cell.extend(Vec2(spec.origin_x + (ix + 1) * spec.cell, spec.origin_y + (iy + 1) * spec.cell));
+      const bool inside = occupancy.mayBeFree(cell);
+      for (int it = 0; inside && it < spec.nt; ++it)
+      {
+        mask.set(ix, iy, it);
+      }
+    }
+  }
+  return mask;
+}
 }  // namespace
 
 VoxelEngine::VoxelEngine(std::shared_ptr<const MapRayCaster> map, const LocalizerOptions& options)
@@ -47,7 +70,11 @@ VoxelEngine::VoxelEngine(std::shared_ptr<const MapRayCaster> map, const Localize
   {
     throw std::invalid_argument("VoxelEngine: no map");
   }
-  spec_ = GridSpec::fromMap(map_->map(), options_.resolution, options_.theta_resolution);
+  if (map_->map().empty() || !(map_->map().area() > 0.0))
+  {
+    throw std::invalid_argument("the map has no area");
+  }
+  spec_ = GridSpec::fromBounds(searchBounds(*map_, options_), options_.resolution, options_.theta_resolution);
 }
 
 int VoxelEngine::threads() const
@@ -64,6 +91,10 @@ void VoxelEngine::prepare()
   const auto start = std::chrono::steady_clock::now();
   table_ = loadOrBuildTable(*map_, spec_, options_.cache_dir, threads(), &table_source_, &cache_message_);
   windows_ = BoundWindows(CellBounds::compute(*map_, spec_, threads()));
+  if (options_.search_region)
+  {
+    region_mask_ = regionMask(*options_.search_region, spec_);
+  }
   prepared_ = true;
   prepare_seconds_ = secondsSince(start);
 }
@@ -89,7 +120,16 @@ VoxelSet VoxelEngine::rawPreimage(const Reading& reading)
   {
     fillPreimageSlice(reading, it, set);
   }
+  keepRegion(set);
   return set;
+}
+
+void VoxelEngine::keepRegion(VoxelSet& set) const
+{
+  if (!region_mask_.words().empty())
+  {
+    set &= region_mask_;
+  }
 }
 
 std::vector<VoxelSet> VoxelEngine::preimages(const std::vector<Reading>& readings)
@@ -118,6 +158,8 @@ std::vector<VoxelSet> VoxelEngine::preimages(const std::vector<Reading>& reading
   }
   for (std::size_t i = 0; i < readings.size(); ++i)
   {
+    keepRegion(sets[i]);
+    keepRegion(raw[i]);
     if (readings[i].half_angle > 0.0)
     {
       raw[i] = sets[i];

@@ -55,6 +55,15 @@ std::uint64_t doubleBits(double value)
 
 GridSpec GridSpec::fromMap(const PolygonMap& map, int resolution, int theta_resolution)
 {
+  if (map.empty() || !(map.area() > 0.0))
+  {
+    throw std::invalid_argument("the map has no area");
+  }
+  return fromBounds(map.bounds(), resolution, theta_resolution);
+}
+
+GridSpec GridSpec::fromBounds(const Box2& b, int resolution, int theta_resolution)
+{
   if (resolution < 16 || resolution > 1024)
   {
     throw std::invalid_argument("resolution " + std::to_string(resolution) + " is outside [16, 1024]");
@@ -64,13 +73,12 @@ GridSpec GridSpec::fromMap(const PolygonMap& map, int resolution, int theta_reso
     throw std::invalid_argument("theta_resolution " + std::to_string(theta_resolution) +
                                 " is outside [16, 1024] (or 0 = resolution)");
   }
-  if (map.empty() || !(map.area() > 0.0))
-  {
-    throw std::invalid_argument("the map has no area");
-  }
-  const Box2& b = map.bounds();
   const double width = b.max.x() - b.min.x();
   const double height = b.max.y() - b.min.y();
+  if (!(std::max(width, height) > 0.0) || !std::isfinite(width) || !std::isfinite(height))
+  {
+    throw std::invalid_argument("the grid's bounds have no extent");
+  }
   GridSpec spec;
   spec.cell = std::max(width, height) / resolution;
   spec.nx = static_cast<int>(std::ceil(width / spec.cell - 1e-9)) + 2;

@@ -51,6 +51,8 @@ private:
   double cell_xy_;     ///< leaf size [m]
   double cell_theta_;  ///< leaf size [rad]
   std::shared_ptr<const BoxOccupancy> occupancy_;
+  /// The search region's cells (null without one): AdaptiveSearchOptions::positions.
+  std::shared_ptr<const BoxOccupancy> region_occupancy_;
   std::vector<LeafBox> last_leaves_;  ///< built once per map
   /// Cap on the occupancy grid's cells per side (two 4-byte tables: 2048^2 cells = 34 MB).
   static constexpr int kOccupancyCells = 2048;

@@ -66,6 +66,9 @@ struct AdaptiveSearchOptions
   /// The pose box the root grid covers (a local search, e.g. around a tracked pose); unset =
   /// the map's bounding box x [-pi, pi). Its theta span is clamped to 2 pi.
   std::optional<PoseBox> region;
+  /// Where the robot's base may be (LocalizerOptions::search_region): boxes whose positions
+  /// lie wholly outside it are pruned. Null = anywhere in free space. Must outlive the search.
+  const BoxOccupancy* positions = nullptr;
 };
 
 /// The outcome of a box search.

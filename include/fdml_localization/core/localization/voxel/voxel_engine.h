@@ -142,12 +142,16 @@ private:
   void fillPreimageSlice(const Reading& reading, int it, VoxelSet& set) const;
   void localizeRobust(const std::vector<Reading>& readings, Result& result);
   void localizeComponentCentres(const std::vector<Reading>& readings, int min_inliers, Result& result);
+  /// Clears from @p set the voxels whose cell lies wholly outside the search region.
+  void keepRegion(VoxelSet& set) const;
 
   std::shared_ptr<const MapRayCaster> map_;
   LocalizerOptions options_;
   GridSpec spec_;
   DistanceTable table_;
   BoundWindows windows_;
+  /// Voxels whose cell may meet the search region (every heading); empty without a region.
+  VoxelSet region_mask_;
   bool prepared_ = false;
   double prepare_seconds_ = 0.0;
   bool prepare_reported_ = false;

@@ -54,6 +54,8 @@ struct GridSpec
    * @throws std::invalid_argument for a map with no area or a resolution outside [16, 1024]
    */
   static GridSpec fromMap(const PolygonMap& map, int resolution, int theta_resolution);
+  /// The same grid over the box @p bounds [m] (e.g. searchBounds()).
+  static GridSpec fromBounds(const Box2& bounds, int resolution, int theta_resolution);
 
   double thetaStep() const;
   std::size_t voxelCount() const

@@ -79,19 +79,38 @@ bool applyNameFlag(const std::string& flag, const std::function<std::string()>& 
   return true;
 }
 
-/// Applies one option flag that takes a value; false when @p flag is not one of them.
-bool applyValueFlag(const std::string& flag, const std::function<std::string()>& value, Arguments& args)
+/// Applies one flag that names a file (the map, a search region); false for other flags.
+bool applyFileFlag(const std::string& flag, const std::function<std::string()>& value, Arguments& args)
 {
-  core::LocalizerOptions& o = args.options;
-  if (applyNameFlag(flag, value, o))
-  {
-    return true;
-  }
   if (flag == "--map")
   {
     args.map = value();
   }
-  else if (flag == "--resolution" || flag == "--theta-resolution" || flag == "--threads" || flag == "--max-candidates")
+  else if (flag == "--region")
+  {
+    args.region = value();
+  }
+  else if (flag == "--region-seed")
+  {
+    args.region_seed = true;
+    core::parsePoint(value(), flag, args.seed.x(), args.seed.y());
+  }
+  else
+  {
+    return false;
+  }
+  return true;
+}
+
+/// Applies one option flag that takes a value; false when @p flag is not one of them.
+bool applyValueFlag(const std::string& flag, const std::function<std::string()>& value, Arguments& args)
+{
+  core::LocalizerOptions& o = args.options;
+  if (applyNameFlag(flag, value, o) || applyFileFlag(flag, value, args))
+  {
+    return true;
+  }
+  if (flag == "--resolution" || flag == "--theta-resolution" || flag == "--threads" || flag == "--max-candidates")
   {
     const int n = core::parseInteger(value(), flag);
     int& target = flag == "--resolution"       ? o.resolution :
@@ -122,15 +141,6 @@ bool applyValueFlag(const std::string& flag, const std::function<std::string()>&
   else if (flag == "--cache-dir")
   {
     o.cache_dir = value();
-  }
-  else if (flag == "--region")
-  {
-    args.region = value();
-  }
-  else if (flag == "--region-seed")
-  {
-    args.region_seed = true;
-    core::parsePoint(value(), flag, args.seed.x(), args.seed.y());
   }
   else if (flag == "--max-range")
   {
@@ -244,6 +254,18 @@ void printTimes(const core::Result& result)
                c.max_consensus_bound, c.best_consensus, c.regions_at_bound, c.regions_covered, c.regions_excluded,
                c.complete ? "yes" : "no");
 }
+/// The localizer for the map file, its grid tolerances and the search region of @p args.
+core::Localizer localizerFor(const Arguments& args)
+{
+  io::MapFile file = io::readMapFile(args.map);
+  auto map = std::make_shared<const core::MapRayCaster>(std::move(file.map));
+  core::LocalizerOptions options = core::withGridTolerances(args.options, file.cell_size, args.set);
+  if (!args.region.empty())
+  {
+    options.search_region = io::loadSearchRegion(args.region, args.region_seed ? &args.seed : nullptr);
+  }
+  return core::Localizer(map, options);
+}
 }  // namespace
 
 int main(int argc, char** argv)
@@ -263,14 +285,7 @@ int main(int argc, char** argv)
     }
     const tools::CsvReadings csv = tools::readReadingsCsv(args.csv, args.max_range);
     tools::validateCsvReadings(csv, args.csv, args.options);
-    io::MapFile file = io::readMapFile(args.map);
-    auto map = std::make_shared<const core::MapRayCaster>(std::move(file.map));
-    core::LocalizerOptions options = core::withGridTolerances(args.options, file.cell_size, args.set);
-    if (!args.region.empty())
-    {
-      options.search_region = io::loadSearchRegion(args.region, args.region_seed ? &args.seed : nullptr);
-    }
-    core::Localizer localizer(map, options);
+    core::Localizer localizer = localizerFor(args);
     const core::Result result = localizer.localize(csv.readings);
     const std::string cache_warning = core::tableCacheWarning(localizer);
     if (!cache_warning.empty())

@@ -35,6 +35,40 @@ double seedGate(const std::vector<Reading>& readings, const LocalizerOptions& op
                         0.5 * scale.cell_xy + 0.5 * scale.cell_theta * medianFiniteRange(readings));
 }
 
+Pose2 freeStart(const MapRayCaster& map, const Pose2& start, double reach)
+{
+  const Vec2 c = start.position();
+  if (map.isFree(c))
+  {
+    return start;
+  }
+  Box2 near;
+  near.extend(c - Vec2(reach, reach));
+  near.extend(c + Vec2(reach, reach));
+  Vec2 best = c;
+  double best_distance = kInf;
+  const std::vector<Segment>& segments = map.grid().segments();
+  map.grid().forEachSegmentInBox(near, [&](int i) {
+    const Segment& s = segments[static_cast<std::size_t>(i)];
+    const Vec2 d = s.b - s.a;
+    const double length2 = d.squaredNorm();
+    if (!(length2 > 0.0))
+    {
+      return true;
+    }
+    const double t = std::clamp((c - s.a).dot(d) / length2, 0.0, 1.0);
+    const Vec2 p = s.a + t * d + kOffWall * Vec2(-d.y(), d.x()) / std::sqrt(length2);  // free side: the left
+    const double distance = (p - c).norm();
+    if (distance < best_distance && map.isFree(p))
+    {
+      best = p;
+      best_distance = distance;
+    }
+    return true;
+  });
+  return Pose2(best.x(), best.y(), start.theta);
+}
+
 std::vector<Pose2> bestAgreeingPoses(const MapRayCaster& map, const std::vector<Pose2>& poses,
                                      const std::vector<Reading>& readings, double gate, double separation_xy,
                                      double separation_theta, std::size_t max_poses, std::size_t sampled)
@@ -44,7 +78,7 @@ std::vector<Pose2> bestAgreeingPoses(const MapRayCaster& map, const std::vector<
   const std::size_t samples = std::min(n, sampled);
   for (std::size_t s = 0; s < samples; ++s)
   {
-    const Pose2& pose = poses[s * n / samples];
+    const Pose2 pose = freeStart(map, poses[s * n / samples], 0.5 * separation_xy);
     const PoseEvaluation e = evaluatePose(map, pose, readings, gate);
     double score = static_cast<double>(readings.size() - e.inliers) * gate * gate;
     for (std::size_t i = 0; i < readings.size(); ++i)

@@ -185,7 +185,7 @@ struct StageTimes
  *        readings a pose explains within the range tolerance tau (LocalizerOptions::
  *        range_tolerance): |h - d| <= tau, the sensor in free space, a no-return reading when
  *        nothing in range is nearer than max_range - tau. Poses are those of the searched space
- *        (the map's bounding box x [-pi, pi), the robot's base in free space).
+ *        (searchBounds() x [-pi, pi), the robot's base in free space and in the search region).
  */
 struct Certificate
 {

@@ -32,10 +32,23 @@ struct SeedScale
  */
 double seedGate(const std::vector<Reading>& readings, const LocalizerOptions& options, const SeedScale& scale);
 
+/// How far into free space freeStart() moves a start off a wall [m].
+constexpr double kOffWall = 1e-3;
+
+/**
+ * @brief @p start, or when its position is not free (a cell's centre inside a wall, while the
+ *        cell holds a sliver of free space along it), the free point nearest to it among the
+ *        points kOffWall off the walls within @p reach [m] of it (each wall's point nearest the
+ *        start, moved to its free side); @p start when there is none. A polish started inside a
+ *        wall sees no gradient.
+ */
+Pose2 freeStart(const MapRayCaster& map, const Pose2& start, double reach);
+
 /**
  * @brief Of @p poses (of at most @p sampled of them spread over the list), those agreeing best
  *        with @p readings (fewest readings off by more than @p gate [m], then the smallest sum of
- *        squared residuals), at most @p max_poses, pairwise apart by more than @p separation_xy
+ *        squared residuals), each moved off a wall first (freeStart(), within half
+ *        @p separation_xy), at most @p max_poses, pairwise apart by more than @p separation_xy
  *        [m] or @p separation_theta [rad]; best first.
  */
 std::vector<Pose2> bestAgreeingPoses(const MapRayCaster& map, const std::vector<Pose2>& poses,

@@ -55,9 +55,10 @@ std::vector<Pose2> plateauSeeds(const MapRayCaster& map, const std::vector<LeafB
                                 const std::vector<Reading>& readings, double gate, double separation_xy,
                                 double separation_theta, std::size_t max_seeds)
 {
+  const double reach = leaves[cluster.representative].box.x1 - leaves[cluster.representative].box.x0;
   if (cluster.members.size() < 2)
   {
-    return { cluster.centroid };
+    return { freeStart(map, cluster.centroid, reach) };
   }
   const std::size_t n = cluster.members.size();
   const std::size_t samples = std::min(n, kSampledLeaves);
@@ -118,13 +119,13 @@ public:
         seed.promised = level;
         seed.region = c;
         seed.support = static_cast<double>(cluster.size);
-        seed.retry_starts = { found.leaves[cluster.representative].box.centre(),
-                              found.leaves[cluster.members[n / 3]].box.centre(),
-                              found.leaves[cluster.members[(2 * n) / 3]].box.centre() };
+        const auto leafStart = [&](std::size_t m) { return freeStart(map_, found.leaves[m].box.centre(), cell_xy_); };
+        seed.retry_starts = { leafStart(cluster.representative), leafStart(cluster.members[n / 3]),
+                              leafStart(cluster.members[(2 * n) / 3]) };
         const std::size_t spread = std::min(n, kRegionStarts);
         for (std::size_t j = 0; j < spread; ++j)
         {
-          seed.region_starts.push_back(found.leaves[cluster.members[j * n / spread]].box.centre());
+          seed.region_starts.push_back(leafStart(cluster.members[j * n / spread]));
         }
         seeds.push_back(std::move(seed));
       }

@@ -96,20 +96,21 @@ private:
   SearchSeed seedOf(const VoxelCluster& plateau, std::vector<bool> hypothesis) const
   {
     SearchSeed seed;
-    seed.start = plateau.centroid;
+    const GridSpec& spec = engine_.grid();
+    seed.start = freeStart(map_, plateau.centroid, spec.cell);
     seed.hypothesis = std::move(hypothesis);
     seed.promised = plateau.peak_count;
     seed.region = plateau.representative;
     const std::size_t n = plateau.voxels.size();
     for (std::size_t v : { plateau.representative, plateau.voxels[n / 3], plateau.voxels[(2 * n) / 3] })
     {
-      seed.retry_starts.push_back(engine_.grid().centre(v));
+      seed.retry_starts.push_back(freeStart(map_, spec.centre(v), spec.cell));
     }
     // The final multi-start's poses, spread over the plateau: it may hold several optima.
     const std::size_t spread = std::min(n, kRegionStarts);
     for (std::size_t j = 0; j < spread; ++j)
     {
-      seed.region_starts.push_back(engine_.grid().centre(plateau.voxels[j * n / spread]));
+      seed.region_starts.push_back(freeStart(map_, spec.centre(plateau.voxels[j * n / spread]), spec.cell));
     }
     return seed;
   }

@@ -131,7 +131,10 @@ TEST(Params, CoreOptionsAreCopied)
   params.localizer.cache_dir = "/tmp/cache";
   params.localizer.max_boxes = 5000;
   params.localizer.deadline = 1.5;
+  const core::Ring square = { { 0, 0 }, { 1, 0 }, { 1, 1 }, { 0, 1 } };
+  params.search_region_map = std::make_shared<const core::MapRayCaster>(core::PolygonMap::fromRings({ square }));
   const core::LocalizerOptions options = toLocalizerOptions(params);
+  EXPECT_EQ(options.search_region, params.search_region_map);
   EXPECT_EQ(options.engine, core::Engine::Adaptive);
   EXPECT_EQ(options.method, core::Method::Baseline);
   EXPECT_EQ(options.resolution, 64);

@@ -71,8 +71,32 @@ TEST(LocalizerBadParams, OutOfRangeParameterExitsNonZeroNamingItAndItsRange)
   EXPECT_NE(run.exit_code, 0) << run.output;
   EXPECT_NE(run.exit_code, 124) << "timed out: " << run.output;
   EXPECT_NE(run.output.find("~resolution = 5"), std::string::npos) << run.output;
-  EXPECT_NE(run.output.find("[16, 1024]"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("[16, 100000] for engine adaptive"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("~mode"), std::string::npos) << run.output;
+}
+
+TEST(LocalizerBadParams, UnusableSearchRegionExitsNonZeroNamingIt)
+{
+  const RunResult missing =
+      runNode("__name:=missing_region _map_file:=" + kGoodMap + " _search_region:=/nonexistent/fdml/region.poly");
+  EXPECT_NE(missing.exit_code, 0) << missing.output;
+  EXPECT_NE(missing.exit_code, 124) << "timed out: " << missing.output;
+  EXPECT_NE(missing.output.find("~search_region"), std::string::npos) << missing.output;
+  EXPECT_NE(missing.output.find("/nonexistent/fdml/region.poly"), std::string::npos) << missing.output;
+  // A region that does not overlap the map (the test room moved far away).
+  const std::string away = "/tmp/fdml_bad_region_" + std::to_string(::getpid()) + ".poly";
+  FILE* file = std::fopen(away.c_str(), "w");
+  ASSERT_NE(file, nullptr);
+  std::fputs("1000 1000\n1001 1000\n1001 1001\n1000 1001\n", file);
+  std::fclose(file);
+  const RunResult outside = runNode("__name:=outside_region _map_file:=" + kGoodMap + " _search_region:=" + away);
+  std::remove(away.c_str());
+  EXPECT_NE(outside.exit_code, 0) << outside.output;
+  EXPECT_NE(outside.exit_code, 124) << "timed out: " << outside.output;
+  EXPECT_NE(outside.output.find("search region"), std::string::npos) << outside.output;
+  const RunResult seed = runNode("__name:=seed_only _map_file:=" + kGoodMap + " _search_region_seed:=[1.0,1.0]");
+  EXPECT_NE(seed.exit_code, 0) << seed.output;
+  EXPECT_NE(seed.output.find("~search_region_seed"), std::string::npos) << seed.output;
 }
 
 TEST(LocalizerBadParams, WrongTypesExitNonZeroNamingTheParameterAndTheType)

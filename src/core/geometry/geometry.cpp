@@ -181,13 +181,17 @@ bool segmentsIntersect(const Segment& s, const Segment& t)
          (o3 == 0 && onSegment(t.a, t.b, s.a)) || (o4 == 0 && onSegment(t.a, t.b, s.b));
 }
 
-double pointSegmentDistanceSquared(const Vec2& p, const Segment& seg)
+Vec2 closestPointOnSegment(const Vec2& p, const Segment& seg)
 {
   const Vec2 e = seg.b - seg.a;
   const double len2 = e.squaredNorm();
-  double t = len2 > 0.0 ? (p - seg.a).dot(e) / len2 : 0.0;
-  t = std::clamp(t, 0.0, 1.0);
-  return (seg.a + t * e - p).squaredNorm();
+  const double t = len2 > 0.0 ? std::clamp((p - seg.a).dot(e) / len2, 0.0, 1.0) : 0.0;
+  return seg.a + t * e;
+}
+
+double pointSegmentDistanceSquared(const Vec2& p, const Segment& seg)
+{
+  return (closestPointOnSegment(p, seg) - p).squaredNorm();
 }
 
 bool crossesRightOf(const Vec2& p, const Vec2& a, const Vec2& b)

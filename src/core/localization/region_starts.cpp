@@ -51,13 +51,11 @@ Pose2 freeStart(const MapRayCaster& map, const Pose2& start, double reach)
   map.grid().forEachSegmentInBox(near, [&](int i) {
     const Segment& s = segments[static_cast<std::size_t>(i)];
     const Vec2 d = s.b - s.a;
-    const double length2 = d.squaredNorm();
-    if (!(length2 > 0.0))
+    if (!(d.squaredNorm() > 0.0))
     {
       return true;
     }
-    const double t = std::clamp((c - s.a).dot(d) / length2, 0.0, 1.0);
-    const Vec2 p = s.a + t * d + kOffWall * Vec2(-d.y(), d.x()) / std::sqrt(length2);  // free side: the left
+    const Vec2 p = closestPointOnSegment(c, s) + kOffWall * Vec2(-d.y(), d.x()).normalized();  // free side: the left
     const double distance = (p - c).norm();
     if (distance < best_distance && map.isFree(p))
     {

@@ -126,6 +126,9 @@ bool segmentIntersectsBox(const Segment& seg, const Box2& box);
 /// True when the two closed segments share a point.
 bool segmentsIntersect(const Segment& s, const Segment& t);
 
+/// The point of a segment nearest to p (its first end for a degenerate segment).
+Vec2 closestPointOnSegment(const Vec2& p, const Segment& seg);
+
 /// Squared distance from point p to a segment [m^2].
 double pointSegmentDistanceSquared(const Vec2& p, const Segment& seg);
 

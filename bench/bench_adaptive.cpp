@@ -150,6 +150,29 @@ std::vector<Batch> protocolBatches(const core::MapRayCaster& map, int count, boo
   return batches;
 }
 
+/// Localizes the batches in turn, one per iteration: median_ms (median total per call) and
+/// success (fraction whose best candidate is within @p position [m] and @p angle [rad] of the truth).
+void timeCalls(benchmark::State& state, core::Localizer& localizer, const std::vector<Batch>& batches, double position,
+               double angle)
+{
+  std::vector<double> totals;
+  long calls = 0;
+  int success = 0;
+  for (auto _ : state)
+  {
+    const Batch& batch = batches[calls % batches.size()];
+    const core::Result result = localizer.localize(batch.readings);
+    totals.push_back(result.times.total);
+    success += !result.candidates.empty() &&
+               (result.candidates.front().pose.position() - batch.truth.position()).norm() < position &&
+               std::abs(core::angleDiff(result.candidates.front().pose.theta, batch.truth.theta)) < angle;
+    ++calls;
+  }
+  std::sort(totals.begin(), totals.end());
+  state.counters["median_ms"] = totals.empty() ? 0.0 : 1e3 * totals[totals.size() / 2];
+  state.counters["success"] = static_cast<double>(success) / static_cast<double>(std::max(calls, 1L));
+}
+
 void runEngine(benchmark::State& state, const std::string& entry, core::Engine engine, bool outliers)
 {
   const auto map = makeMap(entry);
@@ -178,27 +201,7 @@ void runEngine(benchmark::State& state, const std::string& entry, core::Engine e
         (1024.0 * 1024.0);
   }
   const std::vector<Batch> batches = protocolBatches(*map, 16, outliers);
-  std::vector<double> totals;
-  long calls = 0;
-  int success = 0;
-  for (auto _ : state)
-  {
-    const Batch& batch = batches[calls % batches.size()];
-    const core::Result result = localizer.localize(batch.readings);
-    totals.push_back(result.times.total);
-    if (!result.candidates.empty())
-    {
-      const core::Pose2& best = result.candidates.front().pose;
-      success += ((best.position() - batch.truth.position()).norm() < 0.01 &&
-                  std::abs(core::angleDiff(best.theta, batch.truth.theta)) < 0.1 * core::kPi / 180.0) ?
-                     1 :
-                     0;
-    }
-    ++calls;
-  }
-  std::sort(totals.begin(), totals.end());
-  state.counters["median_ms"] = totals.empty() ? 0.0 : 1e3 * totals[totals.size() / 2];
-  state.counters["success"] = static_cast<double>(success) / static_cast<double>(std::max(calls, 1L));
+  timeCalls(state, localizer, batches, 0.01, 0.1 * core::kPi / 180.0);
   state.counters["resolution"] = options.resolution;
   state.counters["peak_rss_mb"] = peakRssMb();
 }
@@ -227,23 +230,7 @@ void runRegion(benchmark::State& state, core::Engine engine, bool with_region)
   localizer.prepare();
   state.counters["table_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::vector<Batch> batches = protocolBatches(*map, 16, false, corner);
-  std::vector<double> totals;
-  long calls = 0;
-  int success = 0;
-  for (auto _ : state)
-  {
-    const Batch& batch = batches[calls % batches.size()];
-    const core::Result result = localizer.localize(batch.readings);
-    totals.push_back(result.times.total);
-    success +=
-        !result.candidates.empty() &&
-        (result.candidates.front().pose.position() - batch.truth.position()).norm() < 0.05 &&
-        std::abs(core::angleDiff(result.candidates.front().pose.theta, batch.truth.theta)) < 2.0 * core::kPi / 180.0;
-    ++calls;
-  }
-  std::sort(totals.begin(), totals.end());
-  state.counters["median_ms"] = totals.empty() ? 0.0 : 1e3 * totals[totals.size() / 2];
-  state.counters["success"] = static_cast<double>(success) / static_cast<double>(std::max(calls, 1L));
+  timeCalls(state, localizer, batches, 0.05, 2.0 * core::kPi / 180.0);
   state.counters["peak_rss_mb"] = peakRssMb();
 }
 

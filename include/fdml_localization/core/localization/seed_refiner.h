@@ -1,0 +1,88 @@
+/**
+ * @file seed_refiner.h
+ * @brief The steps of refineSeed() (robust_search.h): the state of one refinement. Internal to
+ *        the robust search; declared here so that its steps can live in two sources
+ *        (seed_refinement.cpp: polishes and rounds; seed_refinement_starts.cpp: escapes and the
+ *        multi-start).
+ */
+#pragma once
+
+#include "fdml_localization/core/localization/robust_search.h"
+
+#include <algorithm>
+#include <vector>
+
+namespace fdml_localization
+{
+namespace core
+{
+/// Readings selected by @p use.
+inline int countUsed(const std::vector<bool>& use)
+{
+  return static_cast<int>(std::count(use.begin(), use.end(), true));
+}
+
+/// The state of one refinement (refineSeed()): the best pose so far and the steps that try to
+/// improve it. Internal to the robust search; its steps are in seed_refinement.cpp and
+/// seed_refinement_starts.cpp.
+class Refiner
+{
+public:
+  Refiner(const MapRayCaster& map, const Pose2& seed, const std::vector<Reading>& readings,
+          const std::vector<bool>& hypothesis, const RefinementSettings& settings,
+          const std::vector<Pose2>& region_starts)
+    : map_(map)
+    , seed_(seed)
+    , readings_(readings)
+    , hypothesis_(hypothesis)
+    , settings_(settings)
+    , region_starts_(region_starts)
+    , best_pose_(seed)
+    , best_(evaluatePose(map, seed, readings, settings.agreement_tolerance))
+    , seed_residuals_(best_.residuals)
+  {}
+
+  void firstPolish();
+  void dropShortened();
+  void localSearch();
+  void polishRounds();
+  void escapes();
+  void multiStart();
+  Candidate candidate() const;
+  std::vector<Candidate> ties() const;  ///< the optima multiStart() reached tying the best
+
+private:
+  /// Adopts a polished pose (or a shorter step to it) explaining more readings or a lower RMS.
+  bool consider(const PolishOutcome& polished, bool pull_back = true);
+  /// The polish does not see no-return readings (nor walls its rays newly hit): a step from the
+  /// best pose that contradicts more readings is tried again at fractions of its length.
+  bool pullBack(const PolishOutcome& polished);
+  PolishOutcome polish(const Pose2& start, const std::vector<bool>& use, double scale) const;
+  /// Graduated robustness: the Cauchy scale shrinks from about the seed's error to eps, so
+  /// readings cut short by unknown obstacles lose their pull as the pose settles.
+  void annealFrom(const Pose2& start, const std::vector<bool>& use);
+  /// A reading whose ray grazes a vertex at the optimum jumps there, and its jump holds a
+  /// polish away from the optimum (a heading mirrored about a wall's normal explains the other
+  /// readings almost as well). Polish at a fine Cauchy scale, which discounts the jump, then
+  /// again without the reading left worst; keep whatever improves.
+  void fineFrom(const Pose2& start, const std::vector<bool>& use);
+  /// The finite-range inliers of the best pose, without reading @p drop (-1: none).
+  std::vector<bool> finiteInliers(int drop) const;
+  std::vector<int> escapeTries() const;
+
+  const MapRayCaster& map_;
+  const Pose2 seed_;
+  const std::vector<Reading>& readings_;
+  const std::vector<bool>& hypothesis_;
+  const RefinementSettings& settings_;
+  const std::vector<Pose2>& region_starts_;
+  Pose2 best_pose_;
+  PoseEvaluation best_;
+  const std::vector<double> seed_residuals_;
+  Eigen::Matrix3d best_cov_ = Eigen::Matrix3d::Identity() * 1e6;
+  bool collecting_ = false;
+  std::vector<Candidate> reached_;  ///< every polish result of multiStart() (collect_ties)
+};
+
+}  // namespace core
+}  // namespace fdml_localization

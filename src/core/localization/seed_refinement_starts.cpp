@@ -1,0 +1,163 @@
+// refineSeed()'s later steps (seed_refiner.h): leave-one-out escapes from false minima, the
+// fine polish across a grazing reading's jump, and the multi-start over the region.
+#include "fdml_localization/core/localization/seed_refiner.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+
+namespace fdml_localization
+{
+namespace core
+{
+namespace
+{
+/// Cauchy scale [m] of Refiner::fineFrom()'s polish: about a good range sensor's noise.
+constexpr double kFineScale = 0.002;
+}  // namespace
+
+/// A reading whose ray grazes a vertex at the optimum jumps there, and its jump holds a
+/// polish away from the optimum (a heading mirrored about a wall's normal explains the other
+/// readings almost as well). Polish at a fine Cauchy scale, which discounts the jump, then
+/// again without the reading left worst; keep whatever improves.
+void Refiner::fineFrom(const Pose2& start, const std::vector<bool>& use)
+{
+  const PolishOutcome fine = polish(start, use, kFineScale);
+  consider(fine);
+  const PoseEvaluation at = evaluatePose(map_, fine.pose, readings_, settings_.agreement_tolerance);
+  int worst = -1;
+  for (std::size_t i = 0; i < readings_.size(); ++i)
+  {
+    if (use[i] && std::isfinite(at.residuals[i]) &&
+        (worst < 0 || std::abs(at.residuals[i]) > std::abs(at.residuals[static_cast<std::size_t>(worst)])))
+    {
+      worst = static_cast<int>(i);
+    }
+  }
+  std::vector<bool> rest = use;
+  if (worst >= 0)
+  {
+    rest[static_cast<std::size_t>(worst)] = false;
+  }
+  if (worst >= 0 && countUsed(rest) >= 3)
+  {
+    consider(polish(fine.pose, rest, 0.0));
+  }
+}
+
+/// The readings to leave out in one escape round: the worst one, then those passing nearest a
+/// vertex; empty when fewer than 4 finite inliers remain.
+std::vector<int> Refiner::escapeTries() const
+{
+  std::vector<int> order;
+  for (std::size_t i = 0; i < readings_.size(); ++i)
+  {
+    if (best_.inlier_mask[i] && std::isfinite(readings_[i].range))
+    {
+      order.push_back(static_cast<int>(i));
+    }
+  }
+  if (order.size() < 4)
+  {
+    return {};
+  }
+  const std::vector<double> margins = vertexMargins(map_, best_pose_, readings_, settings_.seed_angle_error);
+  const int worst = *std::max_element(order.begin(), order.end(), [&](int a, int b) {
+    return std::abs(best_.residuals[a]) < std::abs(best_.residuals[b]);
+  });
+  std::vector<int> tries{ worst };
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return margins[a] < margins[b]; });
+  for (std::size_t j = 0; j < order.size() && static_cast<int>(tries.size()) < settings_.escape_tries; ++j)
+  {
+    if (order[j] != worst)
+    {
+      tries.push_back(order[j]);
+    }
+  }
+  return tries;
+}
+
+/// The ray-cast cost is only piecewise smooth: a reading whose ray crosses an occlusion edge
+/// between here and the optimum can hold the polish in a false minimum. Leave out, one at a
+/// time, the readings passing nearest to a vertex and the worst one, and keep the result when
+/// the consensus improves.
+void Refiner::escapes()
+{
+  for (int attempt = 0;
+       attempt < settings_.max_escapes && best_.rms > 1e-9 && best_.inliers >= settings_.escape_min_inliers; ++attempt)
+  {
+    const std::vector<int> tries = escapeTries();
+    bool improved = false;
+    for (std::size_t j = 0; j < tries.size() && !improved; ++j)
+    {
+      improved = consider(polish(best_pose_, finiteInliers(tries[j]), 0.0));
+    }
+    if (!improved)
+    {
+      break;
+    }
+    polishRounds();
+  }
+}
+
+/// The polish is a local descent: the optimum of the region can lie in another basin of the
+/// piecewise-smooth cost. Polish (Cauchy at eps, on the hypothesis's finite readings and the
+/// best pose's inliers) from every pose of a lattice around the best pose, anneal from every
+/// given pose of the region, keep the best.
+void Refiner::multiStart()
+{
+  const int m = settings_.multi_start;
+  const bool exact = best_.rms <= 1e-9 && best_.inliers == static_cast<int>(readings_.size());
+  if (m <= 0 || (exact && !settings_.collect_ties))
+  {
+    return;
+  }
+  std::vector<bool> use = finiteInliers(-1);
+  for (std::size_t i = 0; i < readings_.size(); ++i)
+  {
+    use[i] = use[i] || (hypothesis_[i] && std::isfinite(readings_[i].range));
+  }
+  if (countUsed(use) < 3)
+  {
+    return;
+  }
+  const Pose2 centre = best_pose_;
+  collecting_ = settings_.collect_ties;
+  for (const Pose2& start : region_starts_)
+  {
+    annealFrom(start, use);
+  }
+  for (int a = -m; a <= m; ++a)
+  {
+    for (int b = -m; b <= m; ++b)
+    {
+      for (int c = -m; c <= m; ++c)
+      {
+        if (a != 0 || b != 0 || c != 0)
+        {
+          const Pose2 start(centre.x + a * settings_.multi_start_step, centre.y + b * settings_.multi_start_step,
+                            wrapAngle(centre.theta + c * settings_.multi_start_angle_step));
+          consider(polish(start, use, settings_.agreement_tolerance));
+          if (c != 0)
+          {
+            fineFrom(start, use);
+          }
+        }
+      }
+    }
+  }
+  collecting_ = false;
+  polishRounds();
+}
+
+std::vector<Candidate> Refiner::ties() const
+{
+  std::vector<Candidate> tied;
+  const int net = best_.inliers - best_.contradicted;
+  std::copy_if(reached_.begin(), reached_.end(), std::back_inserter(tied),
+               [&](const Candidate& c) { return netConsensus(c) >= net; });
+  return tied;
+}
+
+}  // namespace core
+}  // namespace fdml_localization

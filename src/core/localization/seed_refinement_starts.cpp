@@ -138,9 +138,9 @@ void Refiner::multiStart()
           const Pose2 start(centre.x + a * settings_.multi_start_step, centre.y + b * settings_.multi_start_step,
                             wrapAngle(centre.theta + c * settings_.multi_start_angle_step));
           consider(polish(start, use, settings_.agreement_tolerance));
-          if (c != 0)
+          if (a == 0 && b == 0)
           {
-            fineFrom(start, use);
+            fineFrom(start, use);  // the heading's other basins, e.g. mirrored about a wall's normal
           }
         }
       }

@@ -223,7 +223,7 @@ void keepInSearchRegion(const MapRayCaster& map, const std::vector<Reading>& rea
   std::vector<Candidate>& c = result.candidates;
   const std::size_t before = c.size();
   c.erase(std::remove_if(c.begin(), c.end(),
-                         [&](const Candidate& x) { return !inSearchRegion(options, Vec2(x.pose.x, x.pose.y)); }),
+                         [&](const Candidate& x) { return !inSearchRegion(options, x.pose.position()); }),
           c.end());
   if (c.size() != before)
   {

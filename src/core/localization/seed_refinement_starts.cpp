@@ -14,6 +14,22 @@ namespace
 {
 /// Cauchy scale [m] of Refiner::fineFrom()'s polish: about a good range sensor's noise.
 constexpr double kFineScale = 0.002;
+
+/// The reading of @p among with the largest finite residual at @p e (the first of equals); -1
+/// when there is none.
+int largestResidual(const PoseEvaluation& e, const std::vector<bool>& among)
+{
+  int worst = -1;
+  for (std::size_t i = 0; i < among.size(); ++i)
+  {
+    if (among[i] && std::isfinite(e.residuals[i]) &&
+        (worst < 0 || std::abs(e.residuals[i]) > std::abs(e.residuals[static_cast<std::size_t>(worst)])))
+    {
+      worst = static_cast<int>(i);
+    }
+  }
+  return worst;
+}
 }  // namespace
 
 /// A reading whose ray grazes a vertex at the optimum jumps there, and its jump holds a
@@ -24,22 +40,14 @@ void Refiner::fineFrom(const Pose2& start, const std::vector<bool>& use)
 {
   const PolishOutcome fine = polish(start, use, kFineScale);
   consider(fine);
-  const PoseEvaluation at = evaluatePose(map_, fine.pose, readings_, settings_.agreement_tolerance);
-  int worst = -1;
-  for (std::size_t i = 0; i < readings_.size(); ++i)
+  const int worst = largestResidual(evaluatePose(map_, fine.pose, readings_, settings_.agreement_tolerance), use);
+  if (worst < 0)
   {
-    if (use[i] && std::isfinite(at.residuals[i]) &&
-        (worst < 0 || std::abs(at.residuals[i]) > std::abs(at.residuals[static_cast<std::size_t>(worst)])))
-    {
-      worst = static_cast<int>(i);
-    }
+    return;
   }
   std::vector<bool> rest = use;
-  if (worst >= 0)
-  {
-    rest[static_cast<std::size_t>(worst)] = false;
-  }
-  if (worst >= 0 && countUsed(rest) >= 3)
+  rest[static_cast<std::size_t>(worst)] = false;
+  if (countUsed(rest) >= 3)
   {
     consider(polish(fine.pose, rest, 0.0));
   }
@@ -62,9 +70,7 @@ std::vector<int> Refiner::escapeTries() const
     return {};
   }
   const std::vector<double> margins = vertexMargins(map_, best_pose_, readings_, settings_.seed_angle_error);
-  const int worst = *std::max_element(order.begin(), order.end(), [&](int a, int b) {
-    return std::abs(best_.residuals[a]) < std::abs(best_.residuals[b]);
-  });
+  const int worst = largestResidual(best_, finiteInliers(-1));
   std::vector<int> tries{ worst };
   std::sort(order.begin(), order.end(), [&](int a, int b) { return margins[a] < margins[b]; });
   for (std::size_t j = 0; j < order.size() && static_cast<int>(tries.size()) < settings_.escape_tries; ++j)

@@ -30,7 +30,8 @@ constexpr double kRandomRadiusNoise = 0.35;
 const char* kUsage = "usage: fdml_bench --map PATH[:SCALE] [--map ...] [--random VERTICES[:SCALE]]\n"
                      "                  --obstacles 10,30 [--radius 0.1] [--k 10] [--min-inliers 6|auto]\n"
                      "                  --resolution 50,100,150,200 --trials 50 [--seed 1]\n"
-                     "                  [--method robust|paper|baseline[,...]] [--engine voxel|adaptive] [--threads "
+                     "                  [--method robust|paper|baseline[,...]] [--engine voxel|adaptive|auto] "
+                     "[--threads "
                      "J]\n"
                      "                  [--moving-obstacles] [--translate] [--noise SIGMA] [--fov DEG]\n"
                      "                  [--no-return constraint|weak|drop]\n"
@@ -207,7 +208,9 @@ std::map<std::string, std::function<void(const std::string&)>> valueFlags(Cli& c
         c.methods.insert(c.methods.end(), methods.begin(), methods.end());
       } },
     { "--engine",
-      [&c](const std::string& v) { c.engine = parseNamed(v, "--engine", "voxel, adaptive", core::parseEngine); } },
+      [&c](const std::string& v) {
+        c.engine = parseNamed(v, "--engine", "voxel, adaptive, auto", core::parseEngine);
+      } },
     { "--threads", [&c](const std::string& v) { c.threads = core::parseInteger(v, "--threads"); } },
     { "--noise", [&p](const std::string& v) { p.noise = core::parseNumber(v, "--noise"); } },
     { "--fov", [&p](const std::string& v) { p.half_angle = parseFov(v); } },

@@ -27,11 +27,10 @@ namespace core = fdml_localization::core;
 std::vector<fdml_test::DriveBatch> patrolBatches(const std::shared_ptr<const core::MapRayCaster>& map, int k)
 {
   const core::ScenarioConfig c = fdml_test::apartmentPatrol(5);
-  std::vector<std::string> errors;
-  fdml_test::Drive drive(core::Simulation::create(c, map, &errors), k, 2);
+  fdml_test::Drive drive(fdml_test::simulate(c, map), k, 2);
   std::vector<fdml_test::DriveBatch> batches;
   fdml_test::DriveBatch batch;
-  while (errors.empty() && batches.size() < 200 && drive.next(&batch, 60.0))
+  while (batches.size() < 200 && drive.next(&batch, 60.0))
   {
     batches.push_back(batch);
   }

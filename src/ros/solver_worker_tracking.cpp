@@ -71,7 +71,11 @@ bool SolverWorker::needsGlobalSearch(bool relocalizing) const
 {
   const core::TrackState state = tracker_->state();
   const bool empty_or_lost = state == core::TrackState::Empty || state == core::TrackState::Lost;
-  const bool stuck = state != core::TrackState::Tracking && updates_since_global_ >= params_.global_interval;
+  // Hypotheses that keep finding fixes are only ambiguous: another search would add aliases of
+  // them, never the evidence that tells them apart. Search again when none has found a fix for
+  // ~global_interval updates (some may still coast on odometry).
+  const bool stuck =
+      tracker_->failedUpdates() >= params_.global_interval && updates_since_global_ >= params_.global_interval;
   if (relocalizing || solveMode(params_) == SolveMode::Continuous)
   {
     return empty_or_lost || stuck;
@@ -171,7 +175,7 @@ core::Result SolverWorker::trackedResult(const Job& job) const
     core::Candidate c = h.last_fix;
     c.pose = core::compose(h.map_to_odom, job.batch.base_first);
     c.support = h.support;
-    c.covariance = h.robust_covariance;
+    c.covariance = h.covariance;
     c.inlier_mask.resize(job.readings.size(), false);
     result.candidates.push_back(c);
   }

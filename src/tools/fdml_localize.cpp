@@ -248,6 +248,12 @@ void printTimes(const core::Result& result)
                1e3 * t.preimages, 1e3 * t.count, 1e3 * t.components, 1e3 * t.verification, 1e3 * t.polish,
                1e3 * t.total);
   const core::Certificate& c = result.certificate;
+  if (c.max_consensus_bound < 0)
+  {
+    std::fprintf(stderr, "certificate: none (this method's test proves no bound; best candidate %d)\n",
+                 c.best_consensus);
+    return;
+  }
   std::fprintf(stderr,
                "certificate: no pose explains more than %d readings within the range tolerance; best candidate %d; "
                "regions at the bound %d (covered %d, excluded %d); complete %s\n",

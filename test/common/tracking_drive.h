@@ -4,12 +4,16 @@
 #pragma once
 
 #include "fdml_localization/core/localization/localizer.h"
+#include "fdml_localization/core/tracking/hypothesis_tracker.h"
 #include "fdml_localization/simulation/simulation.h"
 
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <deque>
 #include <memory>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace fdml_test
@@ -112,6 +116,76 @@ private:
   std::deque<Entry> window_;
 };
 
+/// The simulation of @p config on @p map; throws std::invalid_argument naming the config's
+/// first error.
+inline std::unique_ptr<core::Simulation> simulate(const core::ScenarioConfig& config,
+                                                  std::shared_ptr<const core::MapRayCaster> map)
+{
+  std::vector<std::string> errors;
+  auto sim = core::Simulation::create(config, std::move(map), &errors);
+  if (!sim || !errors.empty())
+  {
+    throw std::invalid_argument("scenario: " + (errors.empty() ? std::string("not created") : errors.front()));
+  }
+  return sim;
+}
+
+/// Right as the rostests score it: within 10 cm and 5 deg of @p truth.
+inline bool right(const core::Pose2& pose, const core::Pose2& truth)
+{
+  return (pose.position() - truth.position()).norm() <= 0.1 &&
+         std::abs(core::angleDiff(pose.theta, truth.theta)) <= 5.0 * M_PI / 180.0;
+}
+
+/**
+ * @brief Scores what @p tracker publishes after its update on @p batch: counts a clearly
+ *        supported hypothesis in @p published and, when it is not right(), in @p wrong.
+ * @return empty, or what a wrong published pose was (for a failure message)
+ */
+inline std::string scorePublished(const core::HypothesisTracker& tracker, const DriveBatch& batch, int* published,
+                                  int* wrong)
+{
+  const core::Hypothesis* best = tracker.clearlySupported();
+  if (!best)
+  {
+    return std::string();
+  }
+  ++*published;
+  const core::Pose2 pose = core::compose(best->map_to_odom, batch.reference);
+  if (right(pose, batch.truth))
+  {
+    return std::string();
+  }
+  ++*wrong;
+  char text[200];
+  std::snprintf(text, sizeof(text), "published (%.3f, %.3f, %.3f) at %.2f s, the truth (%.3f, %.3f, %.3f)", pose.x,
+                pose.y, pose.theta, batch.time, batch.truth.x, batch.truth.y, batch.truth.theta);
+  return text;
+}
+
+/// The tracker's options for the drives' odometry: a random walk of 3 % per square-root metre and
+/// radian, no heading noise from translation; at an update every 2 cm, alpha3 0.15 matches its
+/// variance (as the rostests' launches set).
+inline core::TrackerOptions driveTrackerOptions()
+{
+  core::TrackerOptions o;
+  o.odom_alpha2 = 0.05;
+  o.odom_alpha3 = 0.15;
+  o.odom_alpha4 = 0.1;
+  return o;
+}
+
+/// @p count people walking at random at @p speed [m/s], discs of @p radius [m].
+inline core::ObstacleGroupConfig walkers(int count, double radius, double speed)
+{
+  core::ObstacleGroupConfig g;
+  g.count = count;
+  g.radius = radius;
+  g.motion = core::ObstacleMotion::RandomWalk;
+  g.speed = speed;
+  return g;
+}
+
 /// Four range sensors (front, left, back, right), rays, at @p rate [Hz].
 inline std::vector<core::SensorConfig> fourSensors(double rate, double max_range, double noise)
 {
@@ -180,12 +254,7 @@ inline core::ScenarioConfig apartmentPatrol(int people)
                                             8.0, 0.03, 5);
   if (people > 0)
   {
-    core::ObstacleGroupConfig g;
-    g.count = people;
-    g.radius = 0.25;
-    g.motion = core::ObstacleMotion::RandomWalk;
-    g.speed = 0.5;
-    c.obstacles.push_back(g);
+    c.obstacles.push_back(walkers(people, 0.25, 0.5));
   }
   return c;
 }

@@ -34,7 +34,9 @@ struct BenchConfig
   int trials = 50;                          ///< per (scene, m), shared by every n and method
   std::uint64_t seed = 1;
   std::vector<Method> methods{ Method::Robust };
-  Engine engine = Engine::Voxel;
+  /// Engine::Auto (resolveEngine()): the adaptive engine for the robust method, the voxel engine for
+  /// the paper's and the baseline's (their voxel clouds)
+  Engine engine = Engine::Auto;
   /// LocalizerOptions::no_return
   NoReturnPolicy no_return = NoReturnPolicy::Constraint;
   int min_inliers = 6;       ///< k'; 0 = automatic (robust only)

@@ -283,11 +283,13 @@ Result Localizer::localize(const std::vector<Reading>& readings)
   std::vector<std::size_t> kept;
   const std::vector<Reading> searched = all ? readings : readingsWithReturn(readings, options_, &kept);
   Result result = engine_->localize(searched);
-  if (const VoxelEngine* voxel = dynamic_cast<const VoxelEngine*>(engine_.get()))
+  const VoxelEngine* voxel = dynamic_cast<const VoxelEngine*>(engine_.get());
+  if (voxel && options_.method == Method::Robust)
   {
     // The voxel engine's count field, whose maximum bounds the consensus where its preimage
-    // test is conservative (the adaptive engine certifies its own answer). Under the weak and
-    // drop no-return policies the certificate speaks of the readings with a return.
+    // test is conservative: the robust method's (the paper and baseline methods keep the
+    // paper's own test and prove nothing; the adaptive engine certifies its own answer). Under
+    // the weak and drop no-return policies the certificate speaks of the readings with a return.
     certifyVoxels(*map_, searched, options_.range_tolerance, voxel->grid(), voxel->lastCount(), result);
   }
   keepInSearchRegion(*map_, searched, options_, result);

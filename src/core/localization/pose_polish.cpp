@@ -165,6 +165,20 @@ System buildSystem(const MapRayCaster& map, const Pose2& q, const std::vector<Re
   return sys;
 }
 
+/// Adds @p prior's term, weighted by @p weight (noise_sigma^2, the readings' cost unit), to @p sys.
+void addPrior(System& sys, const Pose2& q, const PosePrior& prior, double weight)
+{
+  if (prior.information.isZero())
+  {
+    return;
+  }
+  const Eigen::Vector3d d(q.x - prior.mean.x, q.y - prior.mean.y, angleDiff(q.theta, prior.mean.theta));
+  const Eigen::Matrix3d w = weight * prior.information;
+  sys.cost += d.dot(w * d);
+  sys.h += w;
+  sys.g += w * d;
+}
+
 Pose2 step(const Pose2& q, const Eigen::Vector3d& delta)
 {
   return Pose2(q.x + delta(0), q.y + delta(1), wrapAngle(q.theta + delta(2)));
@@ -194,7 +208,8 @@ Eigen::Matrix3d poseCovariance(const MapRayCaster& map, const System& sys, doubl
 }  // namespace
 
 PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std::vector<Reading>& readings,
-                         const std::vector<bool>& use, double robust_scale, int max_iterations, double noise_sigma)
+                         const std::vector<bool>& use, double robust_scale, int max_iterations, double noise_sigma,
+                         const PosePrior& prior)
 {
   PolishOutcome out;
   out.pose = start;
@@ -205,7 +220,9 @@ PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std:
     mounts.emplace_back(r.offset.theta);
   }
   std::vector<Vec2> hints(readings.size(), Vec2::Constant(std::numeric_limits<double>::quiet_NaN()));
+  const double prior_weight = noise_sigma * noise_sigma;
   System sys = buildSystem(map, out.pose, readings, mounts, use, robust_scale, hints);
+  addPrior(sys, out.pose, prior, prior_weight);
   double lambda = 1e-3;
   for (int iter = 0; iter < max_iterations && lambda <= 1e8; ++iter)
   {
@@ -220,7 +237,8 @@ PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std:
     // Keep each step local: the model only holds near the current pose (0.5 m, 0.3 rad).
     delta /= std::max({ 1.0, delta.head<2>().norm() / 0.5, std::abs(delta(2)) / 0.3 });
     const Pose2 trial = step(out.pose, delta);
-    const System next = buildSystem(map, trial, readings, mounts, use, robust_scale, hints);
+    System next = buildSystem(map, trial, readings, mounts, use, robust_scale, hints);
+    addPrior(next, trial, prior, prior_weight);
     if (next.cost >= sys.cost)
     {
       lambda *= 4.0;

@@ -57,7 +57,8 @@ bool Refiner::pullBack(const PolishOutcome& polished)
 
 PolishOutcome Refiner::polish(const Pose2& start, const std::vector<bool>& use, double scale) const
 {
-  return polishPose(map_, start, readings_, use, scale, settings_.max_iterations, settings_.noise_sigma);
+  return polishPose(map_, start, readings_, use, scale, settings_.max_iterations, settings_.noise_sigma,
+                    settings_.prior);
 }
 
 /// Graduated robustness: the Cauchy scale shrinks from about the seed's error to eps, so

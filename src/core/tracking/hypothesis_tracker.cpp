@@ -88,7 +88,6 @@ void HypothesisTracker::accumulateMotion(const Pose2& reference)
       h.turned += std::abs(d.theta);
       const Pose2 base = compose(h.map_to_odom, last_reference_);
       h.covariance = predictCovariance(h.covariance, base, d, noise);
-      h.robust_covariance = predictCovariance(h.robust_covariance, base, d, noise);
     }
   }
   last_reference_ = reference;
@@ -118,7 +117,6 @@ void HypothesisTracker::seed(const std::vector<Candidate>& candidates, const Pos
     h.support = support;
     h.last_fix = c;
     h.covariance = initialCovariance(c);
-    h.robust_covariance = h.covariance;
     hypotheses_.push_back(std::move(h));
   }
   if (!candidates.empty())
@@ -128,11 +126,16 @@ void HypothesisTracker::seed(const std::vector<Candidate>& candidates, const Pos
   prune();
 }
 
+Eigen::Matrix3d HypothesisTracker::leastCovariance() const
+{
+  const Eigen::Vector3d floor(options_.box_min_xy / 3.0, options_.box_min_xy / 3.0, options_.box_min_theta / 3.0);
+  return floor.cwiseProduct(floor).asDiagonal();
+}
+
 Eigen::Matrix3d HypothesisTracker::initialCovariance(const Candidate& candidate) const
 {
   // At least the smallest search box (as 3 sigma): a global search's polish may be overconfident.
-  const Eigen::Vector3d floor(options_.box_min_xy / 3.0, options_.box_min_xy / 3.0, options_.box_min_theta / 3.0);
-  const Eigen::Matrix3d least = floor.cwiseProduct(floor).asDiagonal();
+  const Eigen::Matrix3d least = leastCovariance();
   const Eigen::Matrix3d& polished = candidate.covariance;
   return polished.allFinite() && polished.diagonal().minCoeff() > 0.0 ? Eigen::Matrix3d(polished + least) : least;
 }
@@ -186,7 +189,11 @@ bool HypothesisTracker::updateOne(Hypothesis& h, const std::vector<Reading>& rea
 {
   const double k = static_cast<double>(readings.size());
   const PoseBox box = boxOf(h, reference);
-  const LocalSolveOutcome found = localSolve(*map_, occupancy_, readings, box, settings);
+  const Pose2 predicted = compose(h.map_to_odom, reference);
+  // The prediction, no more certain than the smallest box, is the polish's prior.
+  LocalSolveSettings local = settings;
+  local.prior = PosePrior{ predicted, informationOf(h.covariance + leastCovariance()) };
+  const LocalSolveOutcome found = localSolve(*map_, occupancy_, readings, box, local);
   report.best_possible = std::max(report.best_possible, found.best_possible);
   report.truncated = report.truncated || found.truncated;
   if (found.fixes.empty())
@@ -199,27 +206,11 @@ bool HypothesisTracker::updateOne(Hypothesis& h, const std::vector<Reading>& rea
     h.support = options_.support_decay * h.support + std::max(0, found.best_consensus) / k;
     return false;
   }
-  // Among the fixes tied with the best on net consensus, the one nearest the prediction carries
-  // the hypothesis (the box is its uncertainty: new places come from global solves only).
-  const Pose2 predicted = compose(h.map_to_odom, reference);
-  const int best = netConsensus(found.fixes.front());
-  std::size_t chosen = 0;
-  for (std::size_t i = 1; i < found.fixes.size() && netConsensus(found.fixes[i]) == best; ++i)
-  {
-    if ((found.fixes[i].pose.position() - predicted.position()).norm() <
-        (found.fixes[chosen].pose.position() - predicted.position()).norm())
-    {
-      chosen = i;
-    }
-  }
+  const std::size_t chosen = chooseFix(found.fixes, predicted);
   const Candidate& fix = found.fixes[chosen];
-  const double scale = options_.fix_covariance_scale;
-  const FusedPose fused = fusePose(predicted, h.covariance, fix.pose, scale * fix.covariance);
+  const FusedPose fused = fusePose(predicted, h.covariance, fix.pose, fixNoise(found, chosen));
   h.map_to_odom = compose(fused.pose, inverse(reference));
   h.covariance = fused.covariance;
-  h.robust_covariance =
-      fusePose(predicted, h.robust_covariance, fix.pose, scale * (fix.covariance + found.direction_loss[chosen]))
-          .covariance;
   h.travelled = 0.0;
   h.turned = 0.0;
   h.misses = 0;
@@ -228,6 +219,30 @@ bool HypothesisTracker::updateOne(Hypothesis& h, const std::vector<Reading>& rea
   h.support = options_.support_decay * h.support + static_cast<double>(netConsensus(fix)) / k;
   h.last_fix = fix;
   return true;
+}
+
+Eigen::Matrix3d HypothesisTracker::fixNoise(const LocalSolveOutcome& found, std::size_t i) const
+{
+  // A fix counts with what it loses without any one direction (a person may shorten every
+  // reading of one sensor alike), and as one of k / stride overlapping batches.
+  return options_.fix_covariance_scale * (found.fixes[i].covariance + found.direction_loss[i]);
+}
+
+std::size_t HypothesisTracker::chooseFix(const std::vector<Candidate>& fixes, const Pose2& predicted) const
+{
+  // Among the fixes tied with the best on net consensus, the one nearest the prediction (the box
+  // is the hypothesis's uncertainty: new places come from global solves only).
+  const int best = netConsensus(fixes.front());
+  std::size_t chosen = 0;
+  for (std::size_t i = 1; i < fixes.size() && netConsensus(fixes[i]) == best; ++i)
+  {
+    if ((fixes[i].pose.position() - predicted.position()).norm() <
+        (fixes[chosen].pose.position() - predicted.position()).norm())
+    {
+      chosen = i;
+    }
+  }
+  return chosen;
 }
 
 int HypothesisTracker::prune()
@@ -281,8 +296,8 @@ const Hypothesis* HypothesisTracker::clearlySupported() const
   const double second = hypotheses_.size() > 1 ? hypotheses_[1].support : 0.0;
   const bool clear = best.misses <= options_.tolerated_misses && !best.conflicted &&
                      best.support >= options_.min_support && best.support - second >= options_.support_margin &&
-                     positionSigma3(best.robust_covariance) <= options_.publish_max_xy &&
-                     headingSigma3(best.robust_covariance) <= options_.publish_max_theta;
+                     positionSigma3(best.covariance) <= options_.publish_max_xy &&
+                     headingSigma3(best.covariance) <= options_.publish_max_theta;
   return clear ? &best : nullptr;
 }
 

@@ -65,6 +65,19 @@ AdaptiveSearchOptions searchOptions(const PoseBox& box, const LocalSolveSettings
   options.region = box;
   return options;
 }
+
+/// The shared refinement's settings for leaves of @p settings' size, with its prior.
+RefinementSettings refinementOf(const LocalSolveSettings& settings)
+{
+  RefinementSettings refine;
+  refine.agreement_tolerance = settings.agreement_tolerance;
+  refine.robust_scale = std::max(settings.agreement_tolerance, settings.cell_xy);
+  refine.seed_position_error = settings.cell_xy;
+  refine.seed_angle_error = settings.cell_theta;
+  refine.max_escapes = 1;
+  refine.prior = settings.prior;
+  return refine;
+}
 }  // namespace
 
 bool insideBox(const Pose2& pose, const PoseBox& box, double margin_xy, double margin_theta)
@@ -95,12 +108,7 @@ LocalSolveOutcome localSolve(const MapRayCaster& map, const BoxOccupancy& occupa
     outcome.least_contradicted = evaluatePose(map, box.centre(), readings, settings.agreement_tolerance).contradicted;
     return outcome;
   }
-  RefinementSettings refine;
-  refine.agreement_tolerance = settings.agreement_tolerance;
-  refine.robust_scale = std::max(settings.agreement_tolerance, settings.cell_xy);
-  refine.seed_position_error = settings.cell_xy;
-  refine.seed_angle_error = settings.cell_theta;
-  refine.max_escapes = 1;
+  const RefinementSettings refine = refinementOf(settings);
   std::vector<Candidate> fixes;
   for (const auto& start : startsOf(found.leaves, box, readings.size(), settings))
   {

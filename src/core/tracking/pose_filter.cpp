@@ -51,6 +51,19 @@ FusedPose fusePose(const Pose2& predicted, const Eigen::Matrix3d& prior, const P
   return fused;
 }
 
+Eigen::Matrix3d informationOf(const Eigen::Matrix3d& covariance)
+{
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(covariance);
+  if (!covariance.allFinite() || ldlt.info() != Eigen::Success || !ldlt.isPositive() ||
+      covariance.diagonal().minCoeff() <= 0.0)
+  {
+    return Eigen::Matrix3d::Zero();
+  }
+  const Eigen::Matrix3d information = ldlt.solve(Eigen::Matrix3d::Identity());
+  return information.allFinite() ? Eigen::Matrix3d(0.5 * (information + information.transpose())) :
+                                   Eigen::Matrix3d::Zero();
+}
+
 double positionSigma3(const Eigen::Matrix3d& covariance)
 {
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(covariance.topLeftCorner<2, 2>());

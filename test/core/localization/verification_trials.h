@@ -322,13 +322,14 @@ inline void checkNoiseFree(const Localizer& localizer, const Trial& trial, const
 /// headings (random directions) that the truth alone does not give.
 inline std::string trialLabel(const Trial& trial, int k)
 {
-  char text[160];
-  std::snprintf(text, sizeof(text), "%s map %d k %d %s truth (%.10f, %.10f, %.10f)", geometryName(trial.geometry),
+  // 17 significant digits: every double prints as itself, so the replay is bit-exact.
+  char text[200];
+  std::snprintf(text, sizeof(text), "%s map %d k %d %s truth (%.17g, %.17g, %.17g)", geometryName(trial.geometry),
                 trial.map, k, trial.noisy ? "noisy" : "exact", trial.truth.x, trial.truth.y, trial.truth.theta);
   std::string label = text;
   if (trial.geometry == kNoReturn && !trial.readings.empty())
   {
-    std::snprintf(text, sizeof(text), " max range %.9f", trial.readings.front().max_range);
+    std::snprintf(text, sizeof(text), " max range %.17g", trial.readings.front().max_range);
     label += text;
   }
   if (trial.geometry == kRandom)
@@ -336,7 +337,7 @@ inline std::string trialLabel(const Trial& trial, int k)
     label += " headings";
     for (const Reading& r : trial.readings)
     {
-      std::snprintf(text, sizeof(text), " %.9f", r.offset.theta);
+      std::snprintf(text, sizeof(text), " %.17g", r.offset.theta);
       label += text;
     }
   }

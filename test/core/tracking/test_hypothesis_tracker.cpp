@@ -7,7 +7,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstdlib>
 #include <string>
 
 namespace core = fdml_localization::core;
@@ -23,25 +22,6 @@ std::shared_ptr<const core::MapRayCaster> apartment()
                                                                                                       "poly"));
 }
 
-std::unique_ptr<core::Simulation> simulate(const core::ScenarioConfig& config,
-                                           std::shared_ptr<const core::MapRayCaster> map)
-{
-  std::vector<std::string> errors;
-  auto sim = core::Simulation::create(config, std::move(map), &errors);
-  if (!errors.empty())
-  {
-    ADD_FAILURE() << errors.front();
-    std::abort();
-  }
-  return sim;
-}
-
-bool right(const core::Pose2& pose, const core::Pose2& truth)
-{
-  return (pose.position() - truth.position()).norm() <= 0.1 &&
-         std::abs(core::angleDiff(pose.theta, truth.theta)) <= 5.0 * M_PI / 180.0;
-}
-
 /// The candidate at the true pose of @p batch (what a global solve would give).
 core::Candidate truthCandidate(const DriveBatch& batch)
 {
@@ -52,53 +32,38 @@ core::Candidate truthCandidate(const DriveBatch& batch)
 
 core::TrackerOptions options()
 {
-  // The drives' odometry: a random walk of 3 % per square-root metre and radian, no heading
-  // noise from translation; at an update every 2 cm, alpha3 0.15 matches its variance (as the
-  // rostests' launches set).
-  core::TrackerOptions o;
-  o.odom_alpha2 = 0.05;
-  o.odom_alpha3 = 0.15;
-  o.odom_alpha4 = 0.1;
-  return o;
+  return fdml_test::driveTrackerOptions();
 }
 }  // namespace
 
 TEST(HypothesisTracker, CarriedByOdometryAmongPeople)
 {
   const auto map = apartment();
-  Drive drive(simulate(fdml_test::apartmentPatrol(5), map), 10, 2);
+  Drive drive(fdml_test::simulate(fdml_test::apartmentPatrol(5), map), 10, 2);
   core::HypothesisTracker tracker(map, options());
   DriveBatch batch;
   ASSERT_TRUE(drive.next(&batch, 60.0));
   tracker.seed({ truthCandidate(batch) }, batch.reference, 0.0);
-  int updates = 0, published = 0, published_right = 0, spoiled = 0;
+  int updates = 0, published = 0, wrong = 0, spoiled = 0;
   while (drive.next(&batch, 60.0))
   {
     tracker.update(batch.readings, batch.reference);
     ++updates;
     spoiled += batch.obstacle_hits >= 2 ? 1 : 0;
-    const core::Hypothesis* best = tracker.clearlySupported();
-    if (best)
-    {
-      ++published;
-      const core::Pose2 pose = core::compose(best->map_to_odom, batch.reference);
-      published_right += right(pose, batch.truth) ? 1 : 0;
-      EXPECT_TRUE(right(pose, batch.truth))
-          << "at " << batch.time << " s: (" << pose.x << ", " << pose.y << ", " << pose.theta << ") vs truth ("
-          << batch.truth.x << ", " << batch.truth.y << ", " << batch.truth.theta << ")";
-    }
+    const std::string error = fdml_test::scorePublished(tracker, batch, &published, &wrong);
+    EXPECT_TRUE(error.empty()) << error;
   }
   EXPECT_GT(updates, 500);
   EXPECT_GE(spoiled, 20) << "the people should spoil some batches";
   // The seeded hypothesis earns support within a few updates and keeps it.
   EXPECT_GE(published, updates * 97 / 100) << published << " of " << updates;
-  EXPECT_EQ(published_right, published);
+  EXPECT_EQ(wrong, 0);
 }
 
 TEST(HypothesisTracker, LoneWeakHypothesisIsNotClearlySupported)
 {
   const auto map = apartment();
-  Drive drive(simulate(fdml_test::apartmentPatrol(0), map), 10, 2);
+  Drive drive(fdml_test::simulate(fdml_test::apartmentPatrol(0), map), 10, 2);
   core::HypothesisTracker tracker(map, options());
   DriveBatch batch;
   ASSERT_TRUE(drive.next(&batch, 10.0));
@@ -120,7 +85,7 @@ TEST(HypothesisTracker, LoneWeakHypothesisIsNotClearlySupported)
 TEST(HypothesisTracker, KidnapIsDetectedAndNeverPublishedLong)
 {
   const auto map = apartment();
-  Drive drive(simulate(fdml_test::apartmentPatrol(3), map), 10, 2);
+  Drive drive(fdml_test::simulate(fdml_test::apartmentPatrol(3), map), 10, 2);
   core::HypothesisTracker tracker(map, options());
   DriveBatch batch;
   ASSERT_TRUE(drive.next(&batch, 20.0));
@@ -138,7 +103,7 @@ TEST(HypothesisTracker, KidnapIsDetectedAndNeverPublishedLong)
     tracker.update(batch.readings, batch.reference);
     ++updates;
     const core::Hypothesis* best = tracker.clearlySupported();
-    wrong += best && !right(core::compose(best->map_to_odom, batch.reference), batch.truth) ? 1 : 0;
+    wrong += best && !fdml_test::right(core::compose(best->map_to_odom, batch.reference), batch.truth) ? 1 : 0;
   }
   EXPECT_EQ(tracker.state(), core::TrackState::Lost);
   // Batches straddling the kidnap (k / stride = 5 of them) may still fit the old pose; then the
@@ -181,7 +146,7 @@ TEST(HypothesisTracker, TwinRoomsStayAmbiguousUntilTheRobotLeaves)
                                                          { 2.0, 2.6 } },
                                                        2.5, 0.02, 3);
   c.robot.radius = 0.15;
-  Drive drive(simulate(c, map), 10, 2);
+  Drive drive(fdml_test::simulate(c, map), 10, 2);
   core::HypothesisTracker tracker(map, options());
   DriveBatch batch;
   ASSERT_TRUE(drive.next(&batch, 5.0));
@@ -196,7 +161,7 @@ TEST(HypothesisTracker, TwinRoomsStayAmbiguousUntilTheRobotLeaves)
     const bool inside = batch.truth.y < 3.3;
     if (best)
     {
-      EXPECT_TRUE(right(core::compose(best->map_to_odom, batch.reference), batch.truth))
+      EXPECT_TRUE(fdml_test::right(core::compose(best->map_to_odom, batch.reference), batch.truth))
           << "a wrong pose is clearly supported at " << batch.time << " s: " << best->map_to_odom.x << ", "
           << core::compose(best->map_to_odom, batch.reference).x << ", "
           << core::compose(best->map_to_odom, batch.reference).y << ", "
@@ -242,7 +207,7 @@ int wrongPublishedBehindAPerson(double direction_group, int* published)
   person.waypoints = { { 11.2, 1.0 }, { 18.2, 1.0 } };
   person.positions = { { 11.2, 1.0 } };
   c.obstacles.push_back(person);
-  Drive drive(simulate(c, map), 10, 2);
+  Drive drive(fdml_test::simulate(c, map), 10, 2);
   DriveBatch batch;
   EXPECT_TRUE(drive.next(&batch, 5.0));
   core::LocalizerOptions global;
@@ -261,7 +226,7 @@ int wrongPublishedBehindAPerson(double direction_group, int* published)
     tracker.update(batch.readings, batch.reference);
     const core::Hypothesis* best = tracker.clearlySupported();
     *published += best ? 1 : 0;
-    wrong += best && !right(core::compose(best->map_to_odom, batch.reference), batch.truth) ? 1 : 0;
+    wrong += best && !fdml_test::right(core::compose(best->map_to_odom, batch.reference), batch.truth) ? 1 : 0;
   }
   return wrong;
 }

@@ -98,3 +98,39 @@ TEST(LocalSolve, RegionSearchKeepsEveryLeafTheWholeSearchKeeps)
     EXPECT_TRUE(covered) << c.x << ", " << c.y << ", " << c.theta;
   }
 }
+
+TEST(LocalSolve, AFixStaysAtThePriorAlongACorridor)
+{
+  // A 40 x 2 m corridor: in its middle the 8 m sensors see only the side walls, so the readings
+  // leave the position along it free and fix the heading only to second order (0.5 mm of range
+  // for 0.03 rad, under the 1 cm noise). The fix takes the readings' position across it and
+  // keeps the prediction (the prior) for the rest; without the prior the polish wanders along
+  // such directions (out of the box, in the building's corridors) or takes the noise's heading.
+  const auto map = std::make_shared<const core::MapRayCaster>(
+      core::PolygonMap::fromRings({ { { 0, 0 }, { 40, 0 }, { 40, 2 }, { 0, 2 } } }));
+  const core::BoxOccupancy occupancy(*map, 0.05);
+  const core::Pose2 truth(20.0, 1.0, 0.0);
+  std::vector<core::Reading> readings;
+  for (int i = 0; i < 10; ++i)
+  {
+    core::Reading r;
+    r.offset = core::Pose2(0.01 * i + 0.15 * std::cos(i * 0.5 * M_PI), 0.15 * std::sin(i * 0.5 * M_PI), i * 0.5 * M_PI);
+    r.max_range = 8.0;
+    r.range = map->range(core::compose(truth, r.offset), r.max_range);
+    readings.push_back(r);
+  }
+  const core::Pose2 predicted(20.08, 1.04, 0.03);
+  core::LocalSolveSettings settings;
+  settings.min_consensus = 8;
+  settings.prior.mean = predicted;
+  settings.prior.information = Eigen::Vector3d(1 / 0.0025, 1 / 0.0025, 1 / 0.0004).asDiagonal();
+  const core::LocalSolveOutcome found =
+      core::localSolve(*map, occupancy, readings, around(predicted, 0.15, 0.06), settings);
+  ASSERT_FALSE(found.fixes.empty());
+  const core::Pose2& fix = found.fixes[0].pose;
+  EXPECT_LT(std::abs(fix.x - predicted.x), 0.01) << fix.x;
+  EXPECT_LT(std::abs(fix.y - truth.y), 0.005) << fix.y;
+  EXPECT_LT(std::abs(core::angleDiff(fix.theta, predicted.theta)), 0.01) << fix.theta;
+  // The fix says the corridor's axis is undetermined (the tracker then keeps its prediction).
+  EXPECT_GT(found.fixes[0].covariance(0, 0), 1.0);
+}

@@ -1,5 +1,5 @@
 /**
- * @file candidate_refinement.h
+ * @file robust_search.h
  * @brief The later stages every engine shares: exact-ray-cast verification of a pose
  *        (inlier mask, RMS residual), the continuous polish (Levenberg-Marquardt on
  *        (x, y, theta) with analytic derivatives of the exact ray cast, covariance estimate),
@@ -59,6 +59,20 @@ struct PolishOutcome
 };
 
 /**
+ * @brief A Gaussian prior on the pose for polishPose(): a tracker's prediction and its
+ *        information (the inverse of its covariance) [1/m^2, 1/rad^2]. The polish then
+ *        minimises the readings' cost plus noise_sigma^2 (p - mean)^T information (p - mean), the
+ *        most probable pose given the readings and the prediction, so that it stays at the
+ *        prediction along a direction the readings leave undetermined (a corridor's axis)
+ *        instead of sliding along it. A zero information is no prior.
+ */
+struct PosePrior
+{
+  Pose2 mean;
+  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
+};
+
+/**
  * @brief Nonlinear least squares on the finite-range readings selected by @p use, from
  *        @p start: Levenberg-Marquardt on (x, y, theta) with the analytic derivative of the exact
  *        ray cast (the hit edge's normal), or of the exact cone cast for a cone reading
@@ -66,9 +80,12 @@ struct PolishOutcome
  *        constant penalty, so the polish does not walk through walls.
  * @param robust_scale Cauchy loss scale [m]; 0 = plain least squares
  * @param noise_sigma lower bound on the residual standard deviation used for the covariance [m]
+ * @param prior a prior on the pose (PosePrior); the covariance returned is still the readings'
+ *        alone, so that a tracker can fuse it with its prediction
  */
 PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std::vector<Reading>& readings,
-                         const std::vector<bool>& use, double robust_scale, int max_iterations, double noise_sigma);
+                         const std::vector<bool>& use, double robust_scale, int max_iterations, double noise_sigma,
+                         const PosePrior& prior = PosePrior());
 
 /**
  * @brief What the covariance of @p pose (from the finite readings selected by @p use, as
@@ -116,6 +133,8 @@ struct RefinementSettings
   /// reaches with the best one's net consensus (refineSeed()'s @p ties): several exact poses
   /// can share one region (a mirror heading a few cells away).
   bool collect_ties = false;
+  /// A prior every polish adds (PosePrior): a tracker's prediction. None by default.
+  PosePrior prior;
 };
 
 /**

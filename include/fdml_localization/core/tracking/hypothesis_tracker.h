@@ -106,12 +106,12 @@ struct Hypothesis
   double support = 0.0;     ///< decayed sum of net consensus / k
   int misses = 0;           ///< updates in a row without a fix
   bool conflicted = false;  ///< the last update was a miss in conflict (TrackerOptions::conflict_readings)
-  /// Of the base's pose map_to_odom (+) the tracker's last reference (x, y, theta) [m^2, rad^2]:
-  /// the filter's, from every reading (the pose and its search box follow it)
+  /// Of the base's pose map_to_odom (+) the tracker's last reference (x, y, theta) [m^2, rad^2],
+  /// counting of each fix only what no one direction's readings fix alone
+  /// (LocalSolveOutcome::direction_loss): a person in front of the one sensor that fixes a
+  /// direction moves neither the pose nor its claimed precision. The pose, its search box, the
+  /// publishing rule and the published covariance follow it.
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  /// The same pose's covariance counting of each fix only what no one direction's readings fix
-  /// alone (LocalSolveOutcome::direction_loss): the publishing rule's, and the one published.
-  Eigen::Matrix3d robust_covariance = Eigen::Matrix3d::Zero();
   int fixes = 0;       ///< updates with a fix
   Candidate last_fix;  ///< the last fix (pose of the base at its update's reference)
 };
@@ -208,6 +208,12 @@ private:
                  const LocalSolveSettings& settings, UpdateReport& report);
   /// The covariance a new hypothesis at @p candidate starts with.
   Eigen::Matrix3d initialCovariance(const Candidate& candidate) const;
+  /// The covariance of the smallest search box (box_min_xy, box_min_theta as 3 sigma).
+  Eigen::Matrix3d leastCovariance() const;
+  /// The index of the fix (of at least one) that carries a hypothesis predicted at @p predicted.
+  std::size_t chooseFix(const std::vector<Candidate>& fixes, const Pose2& predicted) const;
+  /// The covariance with which fix @p i of @p found is fused [m^2, rad^2].
+  Eigen::Matrix3d fixNoise(const LocalSolveOutcome& found, std::size_t i) const;
   /// Merges duplicates, drops hypotheses that missed too often, sorts, bounds the count.
   int prune();
 

@@ -9,6 +9,7 @@
 
 #include "fdml_localization/core/localization/adaptive/adaptive_search.h"
 #include "fdml_localization/core/localization/localizer.h"
+#include "fdml_localization/core/localization/robust_search.h"
 #include "fdml_localization/core/localization/voxel/box_occupancy.h"
 
 #include <vector>
@@ -30,6 +31,10 @@ struct LocalSolveSettings
   /// Readings whose mounting headings lie within this [rad] count as one direction
   /// (LocalSolveOutcome::direction_loss). < 0 = no loss computed (zero).
   double direction_group = 0.25;
+  /// The prediction and its information: every polish adds it (PosePrior, robust_search.h), so
+  /// a fix stays at the prediction along directions the readings leave undetermined instead of
+  /// sliding out of the box. Zero information = none.
+  PosePrior prior;
 };
 
 /// The outcome of localSolve().

@@ -50,6 +50,10 @@ struct FusedPose
 FusedPose fusePose(const Pose2& predicted, const Eigen::Matrix3d& prior, const Pose2& measured,
                    const Eigen::Matrix3d& noise);
 
+/// The information (inverse) of @p covariance; zero (no information) when it is not finite or
+/// not positive definite.
+Eigen::Matrix3d informationOf(const Eigen::Matrix3d& covariance);
+
 /// 3 standard deviations of @p covariance along its least certain direction in (x, y) [m].
 double positionSigma3(const Eigen::Matrix3d& covariance);
 /// 3 standard deviations of the heading [rad].

@@ -168,6 +168,30 @@ std::vector<VoxelSet> VoxelEngine::preimages(const std::vector<Reading>& reading
   return sets;
 }
 
+std::vector<VoxelSet> VoxelEngine::paperPreimages(const std::vector<Reading>& readings)
+{
+  prepare();
+  const long k = static_cast<long>(readings.size());
+  const long nt = spec_.nt;
+  std::vector<VoxelSet> raw(readings.size(), VoxelSet(spec_));
+  std::vector<VoxelSet> sets(readings.size());
+#pragma omp parallel num_threads(threads())
+  {
+#pragma omp for schedule(static)
+    for (long job = 0; job < k * nt; ++job)
+    {
+      fillSampleSlice(readings[job / nt], static_cast<int>(job % nt), raw[job / nt]);
+    }
+#pragma omp for schedule(dynamic, 1)
+    for (long i = 0; i < k; ++i)
+    {
+      keepRegion(raw[i]);
+      sets[i] = raw[i].dilated();
+    }
+  }
+  return sets;
+}
+
 void VoxelEngine::countField(const std::vector<VoxelSet>& sets, std::vector<std::uint8_t>& count) const
 {
   count.assign(spec_.voxelCount(), 0);
@@ -249,7 +273,15 @@ Result VoxelEngine::localize(const std::vector<Reading>& readings)
   }
 
   auto stage = std::chrono::steady_clock::now();
-  sets_ = preimages(readings, raw_sets_);
+  if (options_.method == Method::Robust)
+  {
+    sets_ = preimages(readings, raw_sets_);
+  }
+  else
+  {
+    sets_ = paperPreimages(readings);
+    raw_sets_.clear();
+  }
   result.times.preimages = secondsSince(stage);
 
   stage = std::chrono::steady_clock::now();

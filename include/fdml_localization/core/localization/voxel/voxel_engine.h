@@ -81,10 +81,17 @@ public:
    *        a cone reading's is its conservative preimage).
    */
   std::vector<VoxelSet> preimages(const std::vector<Reading>& readings, std::vector<VoxelSet>& raw);
+  /**
+   * @brief The paper's preimages (docs/METHOD.md, section 2), the paper and baseline methods'
+   *        test: the sample preimages (see preimages()) dilated by one voxel, its completeness
+   *        heuristic. Not conservative: those methods prove no bound (Certificate).
+   */
+  std::vector<VoxelSet> paperPreimages(const std::vector<Reading>& readings);
   /// count[v] = number of sets holding voxel v (at most 255 sets).
   void countField(const std::vector<VoxelSet>& sets, std::vector<std::uint8_t>& count) const;
 
-  /// The count field and the conservative preimages of the last localize() call.
+  /// The count field and the preimages of the last localize() call: conservative with the robust
+  /// method, the paper's (paperPreimages()) with the paper and baseline methods.
   const std::vector<std::uint8_t>& lastCount() const
   {
     return count_;

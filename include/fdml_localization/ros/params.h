@@ -96,8 +96,8 @@ struct Params
   // ~tracking_* box options map onto core::TrackerOptions,
   // validated by core::validate() (its tolerances are the localizer's).
   core::TrackerOptions tracker;
-  int global_interval =
-      40;  ///< ~global_interval: updates in a row without any fix before another global search, [1, 1e6]
+  /// ~global_interval: updates in a row without any fix before another global search, [1, 1e6]
+  int global_interval = 40;
   /// ~global_deadline [s]: wall-time budget of each tracking global search (the adaptive engine,
   /// whatever ~engine is; it runs beside the tracking), [0, 3600]; 0 = none. A search cut short
   /// seeds nothing.

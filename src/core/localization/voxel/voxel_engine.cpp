@@ -185,8 +185,8 @@ std::vector<VoxelSet> VoxelEngine::paperPreimages(const std::vector<Reading>& re
 #pragma omp for schedule(dynamic, 1)
     for (long i = 0; i < k; ++i)
     {
-      keepRegion(raw[i]);
       sets[i] = raw[i].dilated();
+      keepRegion(sets[i]);
     }
   }
   return sets;

@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <iterator>
 #include <limits>
 #include <numeric>
 
@@ -171,6 +172,12 @@ std::vector<VoxelSet> VoxelEngine::preimages(const std::vector<Reading>& reading
 std::vector<VoxelSet> VoxelEngine::paperPreimages(const std::vector<Reading>& readings)
 {
   prepare();
+  // The sample test is for rays: a cone reading's sample set is its conservative preimage (as
+  // in preimages()), which needs its bound windows.
+  std::vector<Reading> cones;
+  std::copy_if(readings.begin(), readings.end(), std::back_inserter(cones),
+               [](const Reading& r) { return r.half_angle > 0.0; });
+  prepareWindows(cones);
   const long k = static_cast<long>(readings.size());
   const long nt = spec_.nt;
   std::vector<VoxelSet> raw(readings.size(), VoxelSet(spec_));
@@ -180,7 +187,15 @@ std::vector<VoxelSet> VoxelEngine::paperPreimages(const std::vector<Reading>& re
 #pragma omp for schedule(static)
     for (long job = 0; job < k * nt; ++job)
     {
-      fillSampleSlice(readings[job / nt], static_cast<int>(job % nt), raw[job / nt]);
+      const Reading& r = readings[job / nt];
+      if (r.half_angle > 0.0)
+      {
+        fillPreimageSlice(r, static_cast<int>(job % nt), raw[job / nt]);
+      }
+      else
+      {
+        fillSampleSlice(r, static_cast<int>(job % nt), raw[job / nt]);
+      }
     }
 #pragma omp for schedule(dynamic, 1)
     for (long i = 0; i < k; ++i)

@@ -184,14 +184,21 @@ TEST(ConeLocalization, FacingFlatWallsTheCandidateSaysTheHeadingIsLoose)
   EXPECT_LT(variance[0], std::pow(2.0 * kDeg, 2)) << "2 deg cones: the bounding rays fix the heading";
 }
 
+/// One thread at resolution 64: the office localizations below.
+LocalizerOptions officeOptions(Engine engine, Method method)
+{
+  LocalizerOptions options;
+  options.engine = engine;
+  options.method = method;
+  options.threads = 1;
+  options.resolution = 64;
+  return options;
+}
+
 TEST(ConeLocalization, AdaptiveEngineFindsTheTruthWithConeReadings)
 {
   const auto map = test::loadMap("maps/office.poly");
-  LocalizerOptions options;
-  options.engine = Engine::Adaptive;
-  options.threads = 1;
-  options.resolution = 64;
-  AdaptiveEngine engine(map, options);
+  AdaptiveEngine engine(map, officeOptions(Engine::Adaptive, Method::Robust));
   std::mt19937_64 rng(27);
   for (int trial = 0; trial < 3; ++trial)
   {
@@ -211,12 +218,8 @@ TEST(ConeLocalization, PaperMethodKeepsTheConesTruth)
   // the truth stays in M_k' with wide cones too (60 deg half-angle: with the ray's sample test
   // the truth left M_k' in 2 of 3 trials).
   const auto map = test::loadMap("maps/office.poly");
-  LocalizerOptions options;
-  options.engine = Engine::Voxel;
-  options.method = Method::Paper;
+  LocalizerOptions options = officeOptions(Engine::Voxel, Method::Paper);
   options.min_inliers = 10;
-  options.threads = 1;
-  options.resolution = 64;
   VoxelEngine engine(map, options);
   std::mt19937_64 rng(27);
   for (int trial = 0; trial < 3; ++trial)

@@ -58,7 +58,7 @@ bool finiteIn(double value, double lo, double hi)
 std::string trackerParameterName(const std::string& option)
 {
   const bool box = option.rfind("box_", 0) == 0 || option.rfind("cell_", 0) == 0 || option == "max_seeds" ||
-                   option.rfind("merge_", 0) == 0 || option == "direction_group";
+                   option.rfind("merge_", 0) == 0 || option == "direction_group" || option == "fix_gate";
   return (box ? "~tracking_" : "~") + option;
 }
 

@@ -35,7 +35,8 @@ void readTrackingParams(ParamReader& r, Params* p)
                                                     { "tracking_merge_angle", &t.merge_angle },
                                                     { "publish_max_xy", &t.publish_max_xy },
                                                     { "publish_max_theta", &t.publish_max_theta },
-                                                    { "tracking_direction_group", &t.direction_group } };
+                                                    { "tracking_direction_group", &t.direction_group },
+                                                    { "tracking_fix_gate", &t.fix_gate } };
   for (const auto& real : reals)
   {
     r.read(real.first, real.second);

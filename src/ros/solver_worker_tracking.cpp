@@ -96,10 +96,20 @@ void SolverWorker::startGlobalSearch(const Job& job)
   global_search_->readings = job.readings.size();
 }
 
-std::string SolverWorker::collectGlobalSearch()
+std::string SolverWorker::collectGlobalSearch(const Job& job)
 {
-  if (!global_search_ || global_search_->result.wait_for(std::chrono::seconds(0)) != std::future_status::ready)
+  if (!global_search_)
   {
+    return std::string();
+  }
+  if (global_search_->result.wait_for(std::chrono::seconds(0)) != std::future_status::ready)
+  {
+    std::vector<core::TrackerBatch>& since = global_search_->since;
+    if (since.size() >= kMaxCatchUp)
+    {
+      since.erase(since.begin());
+    }
+    since.push_back(core::TrackerBatch{ job.readings, job.batch.base_first });
     return std::string();
   }
   PendingSearch search = std::move(*global_search_);
@@ -115,20 +125,22 @@ std::string SolverWorker::collectGlobalSearch()
   // about the places it did not finish: a lone candidate of it could look unique when it is not.
   if (!global.truncated)
   {
-    tracker_->seed(global.candidates, search.reference, 0.0);
+    tracker_->seed(global.candidates, search.reference, 0.0, search.since);
   }
   {
     std::lock_guard<std::mutex> lock(state_.mutex);
     ++state_.tracking.global_searches;
   }
   char text[200];
-  std::snprintf(text, sizeof(text), "global search: %zu candidate(s)%s in %.3f s%s; %zu hypotheses",
+  std::snprintf(text, sizeof(text),
+                "global search: %zu candidate(s)%s in %.3f s%s, carried through %zu later batches; %zu hypotheses",
                 global.candidates.size(),
                 global.candidates.empty() ? "" :
                                             (", the best explains " + std::to_string(global.candidates[0].inliers) +
                                              " of " + std::to_string(search.readings) + " readings")
                                                 .c_str(),
-                global.times.total, global.truncated ? " (cut short: not seeded)" : "", tracker_->hypotheses().size());
+                global.times.total, global.truncated ? " (cut short: not seeded)" : "", search.since.size(),
+                tracker_->hypotheses().size());
   return text;
 }
 
@@ -190,7 +202,7 @@ std::string SolverWorker::stepTracker(const Directive& directive, const Job& job
     {
       return applyHint(*directive.hint, job);
     }
-    const std::string event = collectGlobalSearch();
+    const std::string event = collectGlobalSearch(job);
     if (!global_search_ && needsGlobalSearch(directive.relocalizing))
     {
       startGlobalSearch(job);

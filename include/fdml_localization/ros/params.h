@@ -93,7 +93,7 @@ struct Params
   // Tracking (docs/localizer_node.md#tracking): ~odom_alpha1..4, ~min_consensus_fraction,
   // ~support_decay, ~min_support, ~support_margin, ~tolerated_misses, ~conflict_readings,
   // ~publish_max_xy, ~publish_max_theta, ~max_misses, ~lost_updates, ~max_hypotheses and the
-  // ~tracking_* box options map onto core::TrackerOptions,
+  // ~tracking_* options (box, cell, merge, direction_group, fix_gate) map onto core::TrackerOptions,
   // validated by core::validate() (its tolerances are the localizer's).
   core::TrackerOptions tracker;
   /// ~global_interval: updates in a row without any fix before another global search, [1, 1e6]

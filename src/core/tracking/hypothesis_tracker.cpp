@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <stdexcept>
 #include <utility>
 
@@ -126,6 +127,30 @@ void HypothesisTracker::seed(const std::vector<Candidate>& candidates, const Pos
   prune();
 }
 
+void HypothesisTracker::seed(const std::vector<Candidate>& candidates, const Pose2& reference, double support,
+                             const std::vector<TrackerBatch>& since)
+{
+  if (since.empty() || candidates.empty())
+  {
+    seed(candidates, reference, support);
+    return;
+  }
+  // The others already stand at since.back(): the new ones catch up alone, then join them.
+  std::vector<Hypothesis> others;
+  others.swap(hypotheses_);
+  const int failed = failed_updates_;
+  last_reference_ = reference;
+  have_reference_ = true;
+  seed(candidates, reference, support);
+  for (const TrackerBatch& batch : since)
+  {
+    update(batch.readings, batch.reference);
+  }
+  hypotheses_.insert(hypotheses_.end(), std::make_move_iterator(others.begin()), std::make_move_iterator(others.end()));
+  failed_updates_ = std::min(failed, failed_updates_);
+  prune();
+}
+
 Eigen::Matrix3d HypothesisTracker::leastCovariance() const
 {
   const Eigen::Vector3d floor(options_.box_min_xy / 3.0, options_.box_min_xy / 3.0, options_.box_min_theta / 3.0);
@@ -208,7 +233,7 @@ bool HypothesisTracker::updateOne(Hypothesis& h, const std::vector<Reading>& rea
   }
   const std::size_t chosen = chooseFix(found.fixes, predicted);
   const Candidate& fix = found.fixes[chosen];
-  const FusedPose fused = fusePose(predicted, h.covariance, fix.pose, fixNoise(found, chosen));
+  const FusedPose fused = fusePose(predicted, h.covariance, fix.pose, fixNoise(h, predicted, found, chosen));
   h.map_to_odom = compose(fused.pose, inverse(reference));
   h.covariance = fused.covariance;
   h.travelled = 0.0;
@@ -221,11 +246,26 @@ bool HypothesisTracker::updateOne(Hypothesis& h, const std::vector<Reading>& rea
   return true;
 }
 
-Eigen::Matrix3d HypothesisTracker::fixNoise(const LocalSolveOutcome& found, std::size_t i) const
+Eigen::Matrix3d HypothesisTracker::fixNoise(const Hypothesis& h, const Pose2& predicted, const LocalSolveOutcome& found,
+                                            std::size_t i) const
 {
-  // A fix counts with what it loses without any one direction (a person may shorten every
-  // reading of one sensor alike), and as one of k / stride overlapping batches.
-  return options_.fix_covariance_scale * (found.fixes[i].covariance + found.direction_loss[i]);
+  // A fix counts as one of k / stride overlapping batches, and with what it loses without any
+  // one direction (a person may shorten every reading of one sensor alike), unless a prediction
+  // as precise as a published pose agrees with it (TrackerOptions::fix_gate).
+  const Candidate& fix = found.fixes[i];
+  const Eigen::Matrix3d own = options_.fix_covariance_scale * fix.covariance;
+  const Eigen::Matrix3d loss = options_.fix_covariance_scale * found.direction_loss[i];
+  if (withinMargins(h.covariance) && squaredMahalanobis(fix.pose, predicted, h.covariance + own) <= options_.fix_gate)
+  {
+    return own;
+  }
+  return own + loss;
+}
+
+bool HypothesisTracker::withinMargins(const Eigen::Matrix3d& covariance) const
+{
+  return positionSigma3(covariance) <= options_.publish_max_xy &&
+         headingSigma3(covariance) <= options_.publish_max_theta;
 }
 
 std::size_t HypothesisTracker::chooseFix(const std::vector<Candidate>& fixes, const Pose2& predicted) const
@@ -296,8 +336,7 @@ const Hypothesis* HypothesisTracker::clearlySupported() const
   const double second = hypotheses_.size() > 1 ? hypotheses_[1].support : 0.0;
   const bool clear = best.misses <= options_.tolerated_misses && !best.conflicted &&
                      best.support >= options_.min_support && best.support - second >= options_.support_margin &&
-                     positionSigma3(best.covariance) <= options_.publish_max_xy &&
-                     headingSigma3(best.covariance) <= options_.publish_max_theta;
+                     withinMargins(best.covariance);
   return clear ? &best : nullptr;
 }
 

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace fdml_localization
 {
@@ -62,6 +63,18 @@ Eigen::Matrix3d informationOf(const Eigen::Matrix3d& covariance)
   const Eigen::Matrix3d information = ldlt.solve(Eigen::Matrix3d::Identity());
   return information.allFinite() ? Eigen::Matrix3d(0.5 * (information + information.transpose())) :
                                    Eigen::Matrix3d::Zero();
+}
+
+double squaredMahalanobis(const Pose2& measured, const Pose2& predicted, const Eigen::Matrix3d& covariance)
+{
+  const Eigen::Matrix3d information = informationOf(covariance);
+  if (information.isZero())
+  {
+    return std::numeric_limits<double>::infinity();
+  }
+  const Eigen::Vector3d d(measured.x - predicted.x, measured.y - predicted.y,
+                          angleDiff(measured.theta, predicted.theta));
+  return d.dot(information * d);
 }
 
 double positionSigma3(const Eigen::Matrix3d& covariance)

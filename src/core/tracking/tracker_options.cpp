@@ -58,6 +58,7 @@ std::vector<std::string> validate(const TrackerOptions& o, const std::function<s
   check(in(o.fix_covariance_scale, 1.0, 1000.0), "fix_covariance_scale", o.fix_covariance_scale, "[1, 1000]");
   check((std::isfinite(o.direction_group) && o.direction_group <= kPi) || o.direction_group < 0.0, "direction_group",
         o.direction_group, "[0, pi] rad, or < 0 (off)");
+  check(in(o.fix_gate, 0.0, 1e6), "fix_gate", o.fix_gate, "[0, 1e6]");
   check(o.max_seeds >= 0 && o.max_seeds <= 100, "max_seeds", o.max_seeds, "an integer in [0, 100]");
   return errors;
 }

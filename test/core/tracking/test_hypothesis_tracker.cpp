@@ -249,8 +249,10 @@ TEST(HypothesisTracker, OptionsAreValidated)
   o.support_decay = 1.0;
   o.cell_xy = 0.5;
   o.max_hypotheses = 0;
+  o.fix_gate = -1.0;
   const auto errors = core::validate(o, [](const std::string& n) { return "~tracker_" + n; });
-  ASSERT_EQ(errors.size(), 3u);
+  ASSERT_EQ(errors.size(), 4u);
+  EXPECT_NE(errors[3].find("~tracker_fix_gate = -1"), std::string::npos) << errors[3];
   EXPECT_NE(errors[0].find("~tracker_cell_xy"), std::string::npos) << errors[0];
   EXPECT_THROW(core::HypothesisTracker(apartment(), o), std::invalid_argument);
 }

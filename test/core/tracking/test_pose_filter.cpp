@@ -57,3 +57,13 @@ TEST(PoseFilter, AFixWithoutCovarianceIsTakenAsItIs)
   EXPECT_EQ(fused.covariance, prior);
   EXPECT_NEAR(core::positionSigma3(Eigen::Vector3d(0.04, 0.01, 0.0).asDiagonal()), 0.6, 1e-12);
 }
+
+TEST(PoseFilter, SquaredMahalanobisWrapsTheHeading)
+{
+  // 3 cm in x at 1 cm, 0.02 rad across +-pi at 0.01 rad: 9 + 4.
+  const Eigen::Matrix3d covariance = Eigen::Vector3d(1e-4, 1e-4, 1e-4).asDiagonal();
+  const core::Pose2 a(1.03, 2.0, core::kPi - 0.01);
+  const core::Pose2 b(1.0, 2.0, -core::kPi + 0.01);
+  EXPECT_NEAR(core::squaredMahalanobis(a, b, covariance), 13.0, 1e-9);
+  EXPECT_TRUE(std::isinf(core::squaredMahalanobis(a, b, Eigen::Matrix3d::Zero())));
+}

@@ -54,6 +54,10 @@ FusedPose fusePose(const Pose2& predicted, const Eigen::Matrix3d& prior, const P
 /// not positive definite.
 Eigen::Matrix3d informationOf(const Eigen::Matrix3d& covariance);
 
+/// The squared Mahalanobis distance of @p measured from @p predicted (heading difference
+/// wrapped) under @p covariance; +inf when the covariance is not finite or not positive definite.
+double squaredMahalanobis(const Pose2& measured, const Pose2& predicted, const Eigen::Matrix3d& covariance);
+
 /// 3 standard deviations of @p covariance along its least certain direction in (x, y) [m].
 double positionSigma3(const Eigen::Matrix3d& covariance);
 /// 3 standard deviations of the heading [rad].

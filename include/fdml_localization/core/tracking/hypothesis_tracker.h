@@ -12,9 +12,11 @@
  * Poses: the readings of an update are relative to the base at the odometry pose `reference`
  * (the node's batches: the base at the first reading); a hypothesis's pose of the base at any
  * odometry pose o is map_to_odom (+) o. Each hypothesis also carries the covariance of that pose
- * (pose_filter.h: odometry steps spread it, fixes shrink it), and a robust covariance counting
- * of each fix only what no one direction's readings fix alone; it is published only while the
- * robust one is within the publishing margins (publish_max_xy, publish_max_theta).
+ * (pose_filter.h: odometry steps spread it, fixes shrink it), counting of each fix only what no
+ * one direction's readings fix alone, except where a prediction already within the publishing
+ * margins agrees with the fix (TrackerOptions::fix_gate); it is published only while within
+ * those margins (publish_max_xy, publish_max_theta). A global search's candidates may join late:
+ * seed() with the batches since carries them through those first.
  */
 #pragma once
 

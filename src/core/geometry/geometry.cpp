@@ -46,6 +46,11 @@ Pose2 between(const Pose2& a, const Pose2& b)
   return compose(inverse(a), b);
 }
 
+Eigen::Vector3d poseDifference(const Pose2& a, const Pose2& b)
+{
+  return Eigen::Vector3d(a.x - b.x, a.y - b.y, angleDiff(a.theta, b.theta));
+}
+
 Vec2 transformPoint(const Pose2& a, const Vec2& p)
 {
   const double c = std::cos(a.theta);

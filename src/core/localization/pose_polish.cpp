@@ -172,7 +172,7 @@ void addPrior(System& sys, const Pose2& q, const PosePrior& prior, double weight
   {
     return;
   }
-  const Eigen::Vector3d d(q.x - prior.mean.x, q.y - prior.mean.y, angleDiff(q.theta, prior.mean.theta));
+  const Eigen::Vector3d d = poseDifference(q, prior.mean);
   const Eigen::Matrix3d w = weight * prior.information;
   sys.cost += d.dot(w * d);
   sys.h += w;

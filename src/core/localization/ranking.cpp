@@ -56,7 +56,7 @@ void absorbTiedDuplicates(const std::vector<Candidate>& all, double distance, do
   {
     for (Candidate& k : kept)
     {
-      const Eigen::Vector3d d(c.pose.x - k.pose.x, c.pose.y - k.pose.y, angleDiff(c.pose.theta, k.pose.theta));
+      const Eigen::Vector3d d = poseDifference(c.pose, k.pose);
       if (d.head<2>().norm() >= distance || std::abs(d(2)) >= angle)
       {
         continue;

@@ -11,6 +11,17 @@ namespace fdml_localization
 {
 namespace core
 {
+namespace
+{
+/// True when @p covariance is finite and positive definite by its factorisation @p ldlt, with a
+/// positive diagonal: a usable covariance (fusePose(), informationOf()).
+bool positiveDefinite(const Eigen::Matrix3d& covariance, const Eigen::LDLT<Eigen::Matrix3d>& ldlt)
+{
+  return covariance.allFinite() && ldlt.info() == Eigen::Success && ldlt.isPositive() &&
+         covariance.diagonal().minCoeff() > 0.0;
+}
+}  // namespace
+
 Eigen::Matrix3d predictCovariance(const Eigen::Matrix3d& covariance, const Pose2& pose, const Pose2& step,
                                   const OdometryNoise& noise)
 {
@@ -34,16 +45,13 @@ FusedPose fusePose(const Pose2& predicted, const Eigen::Matrix3d& prior, const P
 {
   FusedPose fused{ measured, prior };
   const Eigen::Matrix3d sum = prior + noise;
-  const Eigen::LDLT<Eigen::Matrix3d> usable(noise);
-  if (!noise.allFinite() || !prior.allFinite() || usable.info() != Eigen::Success || !usable.isPositive() ||
-      noise.diagonal().minCoeff() <= 0.0 || std::abs(sum.determinant()) < 1e-30)
+  if (!positiveDefinite(noise, Eigen::LDLT<Eigen::Matrix3d>(noise)) || !prior.allFinite() ||
+      std::abs(sum.determinant()) < 1e-30)
   {
     return fused;
   }
   const Eigen::Matrix3d gain = prior * sum.inverse();
-  const Eigen::Vector3d innovation(measured.x - predicted.x, measured.y - predicted.y,
-                                   angleDiff(measured.theta, predicted.theta));
-  const Eigen::Vector3d step = gain * innovation;
+  const Eigen::Vector3d step = gain * poseDifference(measured, predicted);
   fused.pose = Pose2(predicted.x + step.x(), predicted.y + step.y(), wrapAngle(predicted.theta + step.z()));
   // Joseph form: stays symmetric and positive semi-definite.
   const Eigen::Matrix3d keep = Eigen::Matrix3d::Identity() - gain;
@@ -55,8 +63,7 @@ FusedPose fusePose(const Pose2& predicted, const Eigen::Matrix3d& prior, const P
 Eigen::Matrix3d informationOf(const Eigen::Matrix3d& covariance)
 {
   const Eigen::LDLT<Eigen::Matrix3d> ldlt(covariance);
-  if (!covariance.allFinite() || ldlt.info() != Eigen::Success || !ldlt.isPositive() ||
-      covariance.diagonal().minCoeff() <= 0.0)
+  if (!positiveDefinite(covariance, ldlt))
   {
     return Eigen::Matrix3d::Zero();
   }
@@ -72,8 +79,7 @@ double squaredMahalanobis(const Pose2& measured, const Pose2& predicted, const E
   {
     return std::numeric_limits<double>::infinity();
   }
-  const Eigen::Vector3d d(measured.x - predicted.x, measured.y - predicted.y,
-                          angleDiff(measured.theta, predicted.theta));
+  const Eigen::Vector3d d = poseDifference(measured, predicted);
   return d.dot(information * d);
 }
 

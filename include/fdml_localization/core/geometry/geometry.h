@@ -63,6 +63,10 @@ Pose2 inverse(const Pose2& a);
 /// The relative pose inverse(a) (+) b: b expressed in frame a.
 Pose2 between(const Pose2& a, const Pose2& b);
 
+/// The difference a - b of two poses as a vector (x, y, heading wrapped to (-pi, pi]) [m, m, rad],
+/// in the map frame: what a covariance of (x, y, theta) weighs (not between()).
+Eigen::Vector3d poseDifference(const Pose2& a, const Pose2& b);
+
 /// Applies pose a to a point p given in frame a [m].
 Vec2 transformPoint(const Pose2& a, const Vec2& p);
 

@@ -173,7 +173,7 @@ void LocalizerNode::startRelocalizationLocked(const OutcomePromise& waiter)
 {
   // Fresh readings only: a batch formed before the request is stale.
   state_.buffer.clear();
-  state_.queued_batch.reset();
+  state_.queued_batches.clear();
   if (waiter)
   {
     state_.relocalize_waiters.push_back(waiter);

@@ -54,7 +54,7 @@ void diagnoseLocked(const NodeState& state, const Params& params, diagnostic_upd
   status.add("readings waiting for tf", state.buffer.pendingCount());
   status.add("readings ready", state.buffer.resolvedCount());
   status.add("batches tracked", stats.batches_solved);
-  status.add("batches replaced before solving", stats.batches_replaced);
+  status.add("batches dropped unsolved (the worker fell behind)", stats.batches_dropped);
   status.add("solver errors", stats.solve_errors);
   status.add("last update time [s]", stats.last_solve_time);
   const fdml_localization::Status tracking = state.statusLocked();

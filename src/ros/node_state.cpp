@@ -7,14 +7,18 @@
 
 namespace fdml_localization
 {
-void NodeState::queueBatchLocked(std::unique_ptr<Job> job)
+void NodeState::queueBatchLocked(Job job)
 {
-  // Relocalization waiters stay in relocalize_waiters until a hypothesis is clearly supported.
-  if (queued_batch)
+  // Relocalization waiters stay in relocalize_waiters until a hypothesis is clearly supported;
+  // a dropped batch's waiters (none today) move to the next one.
+  queued_batches.push_back(std::move(job));
+  while (queued_batches.size() > kMaxQueuedBatches)
   {
-    ++stats.batches_replaced;  // a newer batch replaces the queued one
+    std::vector<OutcomePromise>& next = queued_batches[1].waiters;
+    next.insert(next.end(), queued_batches.front().waiters.begin(), queued_batches.front().waiters.end());
+    queued_batches.pop_front();
+    ++stats.batches_dropped;
   }
-  queued_batch = std::move(job);
 }
 
 fdml_localization::Status NodeState::statusLocked() const
@@ -46,11 +50,11 @@ void NodeState::failAllWaitersLocked(const std::string& message)
     waiters.insert(waiters.end(), job.waiters.begin(), job.waiters.end());
   }
   queued_requests.clear();
-  if (queued_batch)
+  for (Job& job : queued_batches)
   {
-    waiters.insert(waiters.end(), queued_batch->waiters.begin(), queued_batch->waiters.end());
-    queued_batch.reset();
+    waiters.insert(waiters.end(), job.waiters.begin(), job.waiters.end());
   }
+  queued_batches.clear();
   for (const OutcomePromise& waiter : waiters)
   {
     waiter->set_value(failed);

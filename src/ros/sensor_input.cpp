@@ -302,11 +302,11 @@ void SensorInput::process()
     Batch batch;
     while (state_.buffer.takeBatch(&batch))
     {
-      std::unique_ptr<Job> job(new Job);
-      job->from_sensors = true;
-      job->generation = state_.generation;
-      job->readings = batch.readings;
-      job->batch = std::move(batch);
+      Job job;
+      job.from_sensors = true;
+      job.generation = state_.generation;
+      job.readings = batch.readings;
+      job.batch = std::move(batch);
       state_.queueBatchLocked(std::move(job));
       queued = true;
     }

@@ -136,7 +136,8 @@ bool SolverWorker::takeWork(Job* job, nav_msgs::OccupancyGrid::ConstPtr* map)
 {
   std::unique_lock<std::mutex> lock(state_.mutex);
   state_.work_ready.wait(lock, [this] {
-    return state_.shutting_down || state_.pending_map || state_.queued_batch || !state_.queued_requests.empty();
+    return state_.shutting_down || state_.pending_map || !state_.queued_batches.empty() ||
+           !state_.queued_requests.empty();
   });
   if (state_.shutting_down)
   {
@@ -155,8 +156,8 @@ bool SolverWorker::takeWork(Job* job, nav_msgs::OccupancyGrid::ConstPtr* map)
   }
   else
   {
-    *job = std::move(*state_.queued_batch);
-    state_.queued_batch.reset();
+    *job = std::move(state_.queued_batches.front());
+    state_.queued_batches.pop_front();
     state_.activity = "solving a batch";
   }
   return true;

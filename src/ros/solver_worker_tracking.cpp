@@ -47,6 +47,22 @@ std::string describeTracking(const core::HypothesisTracker& tracker, int k)
                 second, best.last_fix.inliers, k, best.misses);
   return text;
 }
+
+/// One line per hypothesis for the "tracking" debug logger (rosconsole
+/// ros.fdml_localization.tracking): where each stands, its support and how sure it is.
+void traceHypotheses(const core::HypothesisTracker& tracker, const Job& job)
+{
+  for (const core::Hypothesis& h : tracker.hypotheses())
+  {
+    const core::Pose2 p = core::compose(h.map_to_odom, job.batch.base_newest);
+    ROS_DEBUG_NAMED("tracking",
+                    "t %.2f hypothesis %llu: (%.3f, %.3f, %.3f) support %.2f, %d fixes, %d missed, last fix %d "
+                    "inliers, 3 sigma %.3f m %.3f rad%s",
+                    stampToTime(job.batch.newest_stamp).toSec(), static_cast<unsigned long long>(h.id), p.x, p.y,
+                    p.theta, h.support, h.fixes, h.misses, h.last_fix.inliers, core::positionSigma3(h.covariance),
+                    core::headingSigma3(h.covariance), h.conflicted ? ", conflicted" : "");
+  }
+}
 }  // namespace
 
 SolverWorker::Directive SolverWorker::takeDirective(const Job& job)
@@ -280,6 +296,7 @@ Outcome SolverWorker::trackBatch(const Job& job)
   bool kidnap = false;
   const std::string lost = lostTrackEvent(track, &kidnap);
   event = lost.empty() ? event : lost;
+  traceHypotheses(*tracker_, job);
   core::Result result = trackedResult(job);
   result.times.total = core::secondsSince(start);
   outcome.success = tracker_->clearlySupported() != nullptr;

@@ -13,7 +13,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <deque>
 #include <functional>
 #include <mutex>
 #include <string>
@@ -23,7 +25,8 @@ namespace
 using fdml_test::Pose;
 using fdml_test::Scorer;
 
-/// The newest ~status.
+/// Every ~status since the last forget(): one status may stand for a single batch (the node
+/// publishes one per tracking update), so a poll of the newest alone can miss it.
 class StatusRecorder
 {
 public:
@@ -31,21 +34,34 @@ public:
     : sub_(nh.subscribe("fdml_localizer/status", 50, &StatusRecorder::onStatus, this))
   {}
 
+  /// True when a status received since the last forget() satisfies @p predicate.
   bool seen(const std::function<bool(const fdml_localization::Status&)>& predicate)
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    return predicate(latest_);
+    return std::any_of(received_.begin(), received_.end(), predicate);
+  }
+
+  /// Forgets the statuses received so far: seen() looks at later ones only.
+  void forget()
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    received_.clear();
   }
 
 private:
   void onStatus(const fdml_localization::Status& msg)
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    latest_ = msg;
+    if (received_.size() >= kMaxKept)
+    {
+      received_.pop_front();
+    }
+    received_.push_back(msg);
   }
 
+  static constexpr std::size_t kMaxKept = 100000;
   std::mutex mutex_;
-  fdml_localization::Status latest_;
+  std::deque<fdml_localization::Status> received_;
   ros::Subscriber sub_;
 };
 
@@ -137,14 +153,17 @@ void kidnapAndHints(Fixture& f)
   fdml_localization::Kidnap move;
   move.request.pose.x = 4.0;
   move.request.pose.y = 3.0;
+  f.status.forget();
   ASSERT_TRUE(f.kidnap.call(move));
   ASSERT_TRUE(move.response.success) << move.response.message;
   EXPECT_TRUE(waitFor([&] { return f.status.seen([](const auto& s) { return s.state == s.LOST; }); }, 20.0));
   Pose truth = f.truthNow();
+  f.status.forget();
   f.initialpose.publish(hint(truth.x + 4.0, truth.y + 3.0, truth.yaw, 0.1, 0.05));
   EXPECT_TRUE(waitFor(
       [&] { return f.status.seen([](const auto& s) { return s.message.find("initialpose refused") == 0; }); }, 20.0));
   truth = f.truthNow();
+  f.status.forget();
   f.initialpose.publish(hint(truth.x + 0.15, truth.y - 0.1, truth.yaw + 0.1, 0.2, 0.1));
   EXPECT_TRUE(waitFor([&] { return f.status.seen([](const auto& s) { return s.state == s.TRACKING; }); }, 20.0));
   int right_before = 0;

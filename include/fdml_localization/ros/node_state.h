@@ -51,7 +51,7 @@ struct Job
 struct NodeStatistics
 {
   std::uint64_t batches_solved = 0;
-  std::uint64_t batches_replaced = 0;  ///< replaced by a newer batch before the worker took them
+  std::uint64_t batches_dropped = 0;  ///< dropped unsolved, oldest first, while kMaxQueuedBatches waited
   std::uint64_t solve_errors = 0;
   double last_solve_time = 0.0;  ///< [s]
   int last_candidates = -1;      ///< -1: nothing solved yet
@@ -98,7 +98,7 @@ struct NodeState
   std::mutex mutex;                                ///< guards everything below
   std::condition_variable work_ready;              ///< signalled when a job or a map is queued, or on shutdown
   ReadingBuffer buffer;                            ///< readings waiting for tf and for a batch
-  std::unique_ptr<Job> queued_batch;               ///< newest sensor batch not yet taken by the worker
+  std::deque<Job> queued_batches;                  ///< sensor batches not yet taken by the worker, FIFO
   std::deque<Job> queued_requests;                 ///< ~localize requests, FIFO
   std::vector<OutcomePromise> relocalize_waiters;  ///< answered once a hypothesis is clearly supported
   bool shutting_down = false;
@@ -119,9 +119,14 @@ struct NodeState
   /// The ~status message now (caller holds mutex).
   fdml_localization::Status statusLocked() const;
 
-  /// Queues a sensor batch for the worker; a newer batch replaces a queued one (caller holds
-  /// mutex).
-  void queueBatchLocked(std::unique_ptr<Job> job);
+  /// Sensor batches that may wait for the worker: each batch is one tracking update, and the
+  /// tracker counts each fix as one of k / ~batch_stride overlapping batches, so every batch
+  /// formed is solved; a worker that falls behind drops the oldest rather than lag (4 batches:
+  /// 0.2 s at 10 readings a second with stride 2).
+  static constexpr std::size_t kMaxQueuedBatches = 4;
+  /// Queues a sensor batch for the worker, dropping the oldest beyond kMaxQueuedBatches (caller
+  /// holds mutex).
+  void queueBatchLocked(Job job);
   /// Answers every waiting service call with @p message (caller holds mutex).
   void failAllWaitersLocked(const std::string& message);
 };

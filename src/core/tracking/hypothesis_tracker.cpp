@@ -235,7 +235,7 @@ bool HypothesisTracker::updateOne(Hypothesis& h, const std::vector<Reading>& rea
   const Candidate& fix = found.fixes[chosen];
   const FusedPose fused = fusePose(predicted, h.covariance, fix.pose, fixNoise(h, predicted, found, chosen));
   h.map_to_odom = compose(fused.pose, inverse(reference));
-  h.covariance = fused.covariance;
+  h.covariance = onlyPlace(h.covariance, box, fused, readings, fix) ? fused.covariance : h.covariance;
   h.travelled = 0.0;
   h.turned = 0.0;
   h.misses = 0;
@@ -260,6 +260,33 @@ Eigen::Matrix3d HypothesisTracker::fixNoise(const Hypothesis& h, const Pose2& pr
     return own;
   }
   return own + loss;
+}
+
+bool HypothesisTracker::onlyPlace(const Eigen::Matrix3d& predicted, const PoseBox& box, const FusedPose& fused,
+                                  const std::vector<Reading>& readings, const Candidate& fix) const
+{
+  // The box is capped (box_max_*): where the prediction's 3 sigma reaches beyond it, the local
+  // solve saw only part of where the robot may be. A fix that would bring the hypothesis within
+  // its box there (a door seen along a corridor the drift has made uncertain by metres) may be
+  // one of several alike places: it narrows the hypothesis only once no other place of the
+  // prediction's 3-sigma region may explain as many readings.
+  const Eigen::Vector3d sigma3 = 3.0 * predicted.diagonal().cwiseMax(0.0).cwiseSqrt();
+  const double half_xy = 0.5 * (box.x1 - box.x0);
+  const double half_theta = 0.5 * (box.t1 - box.t0);
+  const bool covered = sigma3.x() <= half_xy && sigma3.y() <= half_xy && sigma3.z() <= half_theta;
+  const bool narrows = positionSigma3(fused.covariance) <= half_xy && headingSigma3(fused.covariance) <= half_theta;
+  if (covered || !narrows || !sigma3.allFinite())
+  {
+    return true;
+  }
+  const Pose2 p = box.centre();
+  const double t = std::min(kPi, sigma3.z());
+  const PoseBox region{
+    p.x - sigma3.x(), p.x + sigma3.x(), p.y - sigma3.y(), p.y + sigma3.y(), p.theta - t, p.theta + t
+  };
+  return onlyPlaceInRegion(*map_, occupancy_, readings, region, fused.pose, std::max(1, netConsensus(fix)),
+                           positionSigma3(fused.covariance), headingSigma3(fused.covariance),
+                           solveSettings(static_cast<int>(readings.size())));
 }
 
 bool HypothesisTracker::withinMargins(const Eigen::Matrix3d& covariance) const

@@ -80,6 +80,29 @@ RefinementSettings refinementOf(const LocalSolveSettings& settings)
 }
 }  // namespace
 
+bool onlyPlaceInRegion(const MapRayCaster& map, const BoxOccupancy& occupancy, const std::vector<Reading>& readings,
+                       const PoseBox& region, const Pose2& pose, int consensus, double distance, double angle,
+                       const LocalSolveSettings& settings)
+{
+  constexpr double kLeavesPerAxis = 128.0;
+  LocalSolveSettings coarse = settings;
+  coarse.cell_xy = std::max(settings.cell_xy, std::max(region.x1 - region.x0, region.y1 - region.y0) / kLeavesPerAxis);
+  coarse.cell_theta = std::max(settings.cell_theta, (region.t1 - region.t0) / kLeavesPerAxis);
+  coarse.min_consensus = consensus;
+  const AdaptiveSearchResult found = adaptiveSearch(map, occupancy, readings, searchOptions(region, coarse));
+  if (found.truncated)
+  {
+    return false;
+  }
+  // A leaf holds poses within a leaf of its centre: one farther than that from the place is
+  // another place.
+  return std::none_of(found.leaves.begin(), found.leaves.end(), [&](const LeafBox& leaf) {
+    const Pose2 centre = leaf.box.centre();
+    return (centre.position() - pose.position()).norm() > distance + 2.0 * coarse.cell_xy ||
+           std::abs(angleDiff(centre.theta, pose.theta)) > angle + 2.0 * coarse.cell_theta;
+  });
+}
+
 bool insideBox(const Pose2& pose, const PoseBox& box, double margin_xy, double margin_theta)
 {
   const double centre_theta = 0.5 * (box.t0 + box.t1);

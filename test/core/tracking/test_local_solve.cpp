@@ -35,6 +35,44 @@ core::PoseBox around(const core::Pose2& p, double xy, double theta)
 {
   return core::PoseBox{ p.x - xy, p.x + xy, p.y - xy, p.y + xy, p.theta - theta, p.theta + theta };
 }
+
+/// A 20 x 2 m corridor with a door niche (0.4 m wide, 0.5 m deep) every 2 m, on both walls
+/// facing each other: a niche pins the position along the corridor, but every niche looks alike.
+std::shared_ptr<const core::MapRayCaster> corridorWithDoors()
+{
+  std::vector<core::Vec2> ring{ core::Vec2(0.0, 0.0) };
+  for (int door = 1; door <= 9; ++door)
+  {
+    const double x = 2.0 * door + 1.0;
+    ring.insert(ring.end(), { core::Vec2(x - 0.2, 0.0), core::Vec2(x - 0.2, -0.5), core::Vec2(x + 0.2, -0.5),
+                              core::Vec2(x + 0.2, 0.0) });
+  }
+  ring.insert(ring.end(), { core::Vec2(20.0, 0.0), core::Vec2(20.0, 2.0) });
+  for (int door = 9; door >= 1; --door)
+  {
+    const double x = 2.0 * door + 1.0;
+    ring.insert(ring.end(), { core::Vec2(x + 0.2, 2.0), core::Vec2(x + 0.2, 2.5), core::Vec2(x - 0.2, 2.5),
+                              core::Vec2(x - 0.2, 2.0) });
+  }
+  ring.push_back(core::Vec2(0.0, 2.0));
+  return std::make_shared<const core::MapRayCaster>(core::PolygonMap::fromRings({ ring }, "doors"));
+}
+
+/// From (x, 1, 0): six north and six south rays, 10 cm apart along the corridor, 3 m max range
+/// (the corridor's ends are out of reach).
+std::vector<core::Reading> doorReadings(const core::MapRayCaster& map, double x)
+{
+  std::vector<core::Reading> readings;
+  for (int i = 0; i < 12; ++i)
+  {
+    core::Reading r;
+    r.offset = core::Pose2(0.1 * (i % 6), 0.0, i < 6 ? core::kPi / 2 : -core::kPi / 2);
+    r.max_range = 3.0;
+    r.range = map.range(core::compose(core::Pose2(x, 1.0, 0.0), r.offset), r.max_range);
+    readings.push_back(r);
+  }
+  return readings;
+}
 }  // namespace
 
 TEST(LocalSolve, FindsTheTruthInEveryBoxHoldingIt)
@@ -133,4 +171,29 @@ TEST(LocalSolve, AFixStaysAtThePriorAlongACorridor)
   EXPECT_LT(std::abs(core::angleDiff(fix.theta, predicted.theta)), 0.01) << fix.theta;
   // The fix says the corridor's axis is undetermined (the tracker then keeps its prediction).
   EXPECT_GT(found.fixes[0].covariance(0, 0), 1.0);
+}
+
+TEST(LocalSolve, OnlyPlaceInRegionSeesTheAlikeDoors)
+{
+  // Readings taken at x = 10.45 by the niches at 11 are explained one door further on (12.45)
+  // too: within 1 m of 12.45 that is the only place; over 9 m the niches at 11, 15 and 17 align
+  // the same way.
+  const auto map = corridorWithDoors();
+  const std::vector<core::Reading> readings = doorReadings(*map, 10.45);
+  ASSERT_NEAR(readings[5].range, 1.5, 1e-9) << "the last north ray looks into the niche";
+  ASSERT_NEAR(readings[0].range, 1.0, 1e-9);
+  const core::Pose2 place(12.45, 1.0, 0.0);
+  core::LocalSolveSettings settings;
+  settings.range_tolerance = 0.02;
+  const int all = static_cast<int>(readings.size());
+  EXPECT_TRUE(core::onlyPlaceInRegion(*map, core::BoxOccupancy(*map, settings.cell_xy), readings,
+                                      around(place, 1.0, 0.1), place, all, 0.1, 0.05, settings));
+  const core::PoseBox corridor{ 3.5, 21.5, 0.5, 1.5, -0.1, 0.1 };
+  EXPECT_FALSE(core::onlyPlaceInRegion(*map, core::BoxOccupancy(*map, settings.cell_xy), readings, corridor, place, all,
+                                       0.1, 0.05, settings));
+  // Where no niche is in reach, the corridor looks alike everywhere, also within 1 m.
+  const std::vector<core::Reading> plain = doorReadings(*map, 9.4);
+  EXPECT_FALSE(core::onlyPlaceInRegion(*map, core::BoxOccupancy(*map, settings.cell_xy), plain,
+                                       around(core::Pose2(9.4, 1.0, 0.0), 1.0, 0.1), core::Pose2(9.4, 1.0, 0.0), all,
+                                       0.1, 0.05, settings));
 }

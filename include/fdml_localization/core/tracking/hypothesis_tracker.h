@@ -15,7 +15,9 @@
  * (pose_filter.h: odometry steps spread it, fixes shrink it), counting of each fix only what no
  * one direction's readings fix alone, except where a prediction already within the publishing
  * margins agrees with the fix (TrackerOptions::fix_gate); it is published only while within
- * those margins (publish_max_xy, publish_max_theta). A global search's candidates may join late:
+ * those margins (publish_max_xy, publish_max_theta). A fix narrows a hypothesis whose 3 sigma
+ * reaches beyond its (capped) box only when no other place of that 3-sigma region may explain
+ * as many readings (onlyPlace()). A global search's candidates may join late:
  * seed() with the batches since carries them through those first.
  */
 #pragma once
@@ -244,6 +246,12 @@ private:
   /// @p predicted [m^2, rad^2].
   Eigen::Matrix3d fixNoise(const Hypothesis& h, const Pose2& predicted, const LocalSolveOutcome& found,
                            std::size_t i) const;
+  /// False when the fix behind @p fused would narrow a hypothesis whose @p predicted covariance
+  /// reaches beyond its search @p box to within the box, while another place of its 3-sigma
+  /// region may explain as many of @p readings (onlyPlaceInRegion()): the fix is then taken
+  /// without its precision.
+  bool onlyPlace(const Eigen::Matrix3d& predicted, const PoseBox& box, const FusedPose& fused,
+                 const std::vector<Reading>& readings, const Candidate& fix) const;
   /// True when 3 standard deviations of @p covariance are within publish_max_xy and
   /// publish_max_theta.
   bool withinMargins(const Eigen::Matrix3d& covariance) const;

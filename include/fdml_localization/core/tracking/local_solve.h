@@ -69,6 +69,19 @@ LocalSolveOutcome localSolve(const MapRayCaster& map, const BoxOccupancy& occupa
                              const std::vector<Reading>& readings, const PoseBox& box,
                              const LocalSolveSettings& settings);
 
+/**
+ * @brief True when @p pose is provably the only place in @p region that may explain
+ *        @p consensus of @p readings: no leaf of a conservative box search over the region (at
+ *        most 128 leaves an axis, never finer than settings' cells) that may explain that many
+ *        lies farther than @p distance [m] or @p angle [rad] from it, beyond its own leaf's
+ *        size. False when the search ran out of its box budget (settings.max_boxes, as a local
+ *        solve's: nothing proved, and a region of a hypothesis coasting for long costs no more).
+ * @param occupancy the map's occupancy at a cell of at most settings.cell_xy
+ */
+bool onlyPlaceInRegion(const MapRayCaster& map, const BoxOccupancy& occupancy, const std::vector<Reading>& readings,
+                       const PoseBox& region, const Pose2& pose, int consensus, double distance, double angle,
+                       const LocalSolveSettings& settings);
+
 /// True when @p pose lies in @p box inflated by @p margin_xy [m] and @p margin_theta [rad]
 /// (theta compared modulo 2 pi).
 bool insideBox(const Pose2& pose, const PoseBox& box, double margin_xy, double margin_theta);

@@ -114,23 +114,15 @@ TEST(HypothesisTracker, KidnapIsDetectedAndNeverPublishedLong)
   EXPECT_LT(wrong, options().tolerated_misses);
 }
 
-namespace
-{
-/// Two identical rooms side by side (x in [0, 4] and [6, 10], y in [0, 4]), each with a door in
-/// its top wall at the same place, opening onto a corridor (y in [4.2, 5.7], x in [0, 16]) that
-/// is not symmetric: its left end is 2 m from the left room's door, 8 m from the right one's.
-core::PolygonMap twinRooms()
-{
-  return core::PolygonMap::fromRings(
-      { { { 0, 0 },    { 4, 0 },   { 4, 4 },   { 2.3, 4 },   { 2.3, 4.2 }, { 7.7, 4.2 }, { 7.7, 4 },
-          { 6, 4 },    { 6, 0 },   { 10, 0 },  { 10, 4 },    { 8.3, 4 },   { 8.3, 4.2 }, { 16, 4.2 },
-          { 16, 5.7 }, { 0, 5.7 }, { 0, 4.2 }, { 1.7, 4.2 }, { 1.7, 4 },   { 0, 4 } } });
-}
-}  // namespace
-
 TEST(HypothesisTracker, TwinRoomsStayAmbiguousUntilTheRobotLeaves)
 {
-  const auto map = std::make_shared<const core::MapRayCaster>(twinRooms());
+  // Two identical rooms side by side, each with a door at the same place onto a corridor that is
+  // not symmetric (maps/twin_rooms.poly).
+  const auto map = std::make_shared<const core::MapRayCaster>(core::loadPolyFile(std::string(FDML_SOURCE_DIR) + "/maps/"
+                                                                                                                "twin_"
+                                                                                                                "rooms."
+                                                                                                                "pol"
+                                                                                                                "y"));
   // Twice round the left room, then out through the door to the corridor's left end.
   core::ScenarioConfig c = fdml_test::waypointScenario({ { 1.0, 1.0 },
                                                          { 3.0, 1.0 },

@@ -94,8 +94,8 @@ bool onlyPlaceInRegion(const MapRayCaster& map, const BoxOccupancy& occupancy, c
   {
     return false;
   }
-  // A leaf holds poses within a leaf of its centre: one farther than that from the place is
-  // another place.
+  // The box test is loose by about a leaf: a leaf within two leaves of the place's own region
+  // may hold the place itself; one farther holds another place.
   return std::none_of(found.leaves.begin(), found.leaves.end(), [&](const LeafBox& leaf) {
     const Pose2 centre = leaf.box.centre();
     return (centre.position() - pose.position()).norm() > distance + 2.0 * coarse.cell_xy ||

@@ -73,8 +73,8 @@ LocalSolveOutcome localSolve(const MapRayCaster& map, const BoxOccupancy& occupa
  * @brief True when @p pose is provably the only place in @p region that may explain
  *        @p consensus of @p readings: no leaf of a conservative box search over the region (at
  *        most 128 leaves an axis, never finer than settings' cells) that may explain that many
- *        lies farther than @p distance [m] or @p angle [rad] from it, beyond its own leaf's
- *        size. False when the search ran out of its box budget (settings.max_boxes, as a local
+ *        lies farther than @p distance [m] or @p angle [rad] from it by more than two leaves
+ *        (the box test's looseness). False when the search ran out of its box budget (settings.max_boxes, as a local
  *        solve's: nothing proved, and a region of a hypothesis coasting for long costs no more).
  * @param occupancy the map's occupancy at a cell of at most settings.cell_xy
  */

@@ -122,7 +122,7 @@ struct NodeState
   /// Sensor batches that may wait for the worker: each batch is one tracking update, and the
   /// tracker counts each fix as one of k / ~batch_stride overlapping batches, so every batch
   /// formed is solved; a worker that falls behind drops the oldest rather than lag (4 batches:
-  /// 0.2 s at 10 readings a second with stride 2).
+  /// 0.2 s at 20 batches a second, four sensors at 10 Hz with stride 2).
   static constexpr std::size_t kMaxQueuedBatches = 4;
   /// Queues a sensor batch for the worker, dropping the oldest beyond kMaxQueuedBatches (caller
   /// holds mutex).

@@ -274,7 +274,9 @@ bool HypothesisTracker::onlyPlace(const Eigen::Matrix3d& predicted, const PoseBo
   const double half_xy = 0.5 * (box.x1 - box.x0);
   const double half_theta = 0.5 * (box.t1 - box.t0);
   const bool covered = sigma3.x() <= half_xy && sigma3.y() <= half_xy && sigma3.z() <= half_theta;
-  const bool narrows = positionSigma3(fused.covariance) <= half_xy && headingSigma3(fused.covariance) <= half_theta;
+  const double fused_xy = positionSigma3(fused.covariance);
+  const double fused_theta = headingSigma3(fused.covariance);
+  const bool narrows = fused_xy <= half_xy && fused_theta <= half_theta;
   if (covered || !narrows || !sigma3.allFinite())
   {
     return true;
@@ -284,9 +286,8 @@ bool HypothesisTracker::onlyPlace(const Eigen::Matrix3d& predicted, const PoseBo
   const PoseBox region{
     p.x - sigma3.x(), p.x + sigma3.x(), p.y - sigma3.y(), p.y + sigma3.y(), p.theta - t, p.theta + t
   };
-  return onlyPlaceInRegion(*map_, occupancy_, readings, region, fused.pose, std::max(1, netConsensus(fix)),
-                           positionSigma3(fused.covariance), headingSigma3(fused.covariance),
-                           solveSettings(static_cast<int>(readings.size())));
+  return onlyPlaceInRegion(*map_, occupancy_, readings, region, fused.pose, std::max(1, netConsensus(fix)), fused_xy,
+                           fused_theta, solveSettings(static_cast<int>(readings.size())));
 }
 
 bool HypothesisTracker::withinMargins(const Eigen::Matrix3d& covariance) const

@@ -2,6 +2,7 @@
 // odometry, support earned over time, a kidnap detected, twin rooms ambiguous until left.
 #include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/core/tracking/hypothesis_tracker.h"
+#include "localizer_test_utils.h"
 #include "tracking_drive.h"
 
 #include <gtest/gtest.h>
@@ -17,9 +18,7 @@ namespace
 {
 std::shared_ptr<const core::MapRayCaster> apartment()
 {
-  return std::make_shared<const core::MapRayCaster>(core::loadPolyFile(std::string(FDML_SOURCE_DIR) + "/maps/"
-                                                                                                      "apartment."
-                                                                                                      "poly"));
+  return core::test::loadMap("maps/apartment.poly");
 }
 
 /// The candidate at the true pose of @p batch (what a global solve would give).
@@ -118,11 +117,7 @@ TEST(HypothesisTracker, TwinRoomsStayAmbiguousUntilTheRobotLeaves)
 {
   // Two identical rooms side by side, each with a door at the same place onto a corridor that is
   // not symmetric (maps/twin_rooms.poly).
-  const auto map = std::make_shared<const core::MapRayCaster>(core::loadPolyFile(std::string(FDML_SOURCE_DIR) + "/maps/"
-                                                                                                                "twin_"
-                                                                                                                "rooms."
-                                                                                                                "pol"
-                                                                                                                "y"));
+  const auto map = core::test::loadMap("maps/twin_rooms.poly");
   // Twice round the left room, then out through the door to the corridor's left end.
   core::ScenarioConfig c = fdml_test::waypointScenario({ { 1.0, 1.0 },
                                                          { 3.0, 1.0 },

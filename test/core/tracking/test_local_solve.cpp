@@ -186,14 +186,13 @@ TEST(LocalSolve, OnlyPlaceInRegionSeesTheAlikeDoors)
   core::LocalSolveSettings settings;
   settings.range_tolerance = 0.02;
   const int all = static_cast<int>(readings.size());
-  EXPECT_TRUE(core::onlyPlaceInRegion(*map, core::BoxOccupancy(*map, settings.cell_xy), readings,
-                                      around(place, 1.0, 0.1), place, all, 0.1, 0.05, settings));
+  const core::BoxOccupancy occupancy(*map, settings.cell_xy);
+  EXPECT_TRUE(
+      core::onlyPlaceInRegion(*map, occupancy, readings, around(place, 1.0, 0.1), place, all, 0.1, 0.05, settings));
   const core::PoseBox corridor{ 3.5, 21.5, 0.5, 1.5, -0.1, 0.1 };
-  EXPECT_FALSE(core::onlyPlaceInRegion(*map, core::BoxOccupancy(*map, settings.cell_xy), readings, corridor, place, all,
-                                       0.1, 0.05, settings));
+  EXPECT_FALSE(core::onlyPlaceInRegion(*map, occupancy, readings, corridor, place, all, 0.1, 0.05, settings));
   // Where no niche is in reach, the corridor looks alike everywhere, also within 1 m.
   const std::vector<core::Reading> plain = doorReadings(*map, 9.4);
-  EXPECT_FALSE(core::onlyPlaceInRegion(*map, core::BoxOccupancy(*map, settings.cell_xy), plain,
-                                       around(core::Pose2(9.4, 1.0, 0.0), 1.0, 0.1), core::Pose2(9.4, 1.0, 0.0), all,
-                                       0.1, 0.05, settings));
+  EXPECT_FALSE(core::onlyPlaceInRegion(*map, occupancy, plain, around(core::Pose2(9.4, 1.0, 0.0), 1.0, 0.1),
+                                       core::Pose2(9.4, 1.0, 0.0), all, 0.1, 0.05, settings));
 }

@@ -4,6 +4,7 @@
 // several places.
 #include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/core/tracking/hypothesis_tracker.h"
+#include "localizer_test_utils.h"
 #include "tracking_drive.h"
 
 #include <gtest/gtest.h>
@@ -49,9 +50,7 @@ core::ScenarioConfig buildingDrive()
 
 std::shared_ptr<const core::MapRayCaster> building()
 {
-  return std::make_shared<const core::MapRayCaster>(core::loadPolyFile(std::string(FDML_SOURCE_DIR) + "/maps/"
-                                                                                                      "building_60x40."
-                                                                                                      "poly"));
+  return core::test::loadMap("maps/building_60x40.poly");
 }
 
 /// The launch's tracker settings (test/rostest/tracking_building.test): the simulated odometry's

@@ -74,8 +74,9 @@ LocalSolveOutcome localSolve(const MapRayCaster& map, const BoxOccupancy& occupa
  *        @p consensus of @p readings: no leaf of a conservative box search over the region (at
  *        most 128 leaves an axis, never finer than settings' cells) that may explain that many
  *        lies farther than @p distance [m] or @p angle [rad] from it by more than two leaves
- *        (the box test's looseness). False when the search ran out of its box budget (settings.max_boxes, as a local
- *        solve's: nothing proved, and a region of a hypothesis coasting for long costs no more).
+ *        (the box test's looseness). False when the search ran out of its box budget
+ *        (settings.max_boxes, as a local solve's: nothing proved, and the region of a hypothesis
+ *        coasting for long costs no more).
  * @param occupancy the map's occupancy at a cell of at most settings.cell_xy
  */
 bool onlyPlaceInRegion(const MapRayCaster& map, const BoxOccupancy& occupancy, const std::vector<Reading>& readings,

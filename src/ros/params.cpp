@@ -313,7 +313,8 @@ std::string describe(const Params& p)
       << p.tracker.odom_alpha3 << ", " << p.tracker.odom_alpha4
       << ", min_consensus_fraction: " << p.tracker.min_consensus_fraction << ", min_support: " << p.tracker.min_support
       << ", support_margin: " << p.tracker.support_margin << ", lost_updates: " << p.tracker.lost_updates
-      << ", max_hypotheses: " << p.tracker.max_hypotheses << ", global_interval: " << p.global_interval
+      << ", max_hypotheses: " << p.tracker.max_hypotheses << ", confirm_searches: " << p.tracker.confirm_searches
+      << ", history_batches: " << p.tracker.history_batches << ", global_interval: " << p.global_interval
       << ", global_deadline: " << p.global_deadline
       << ", publish_initialpose: " << (p.publish_initialpose ? "true" : "false");
   return out.str();

@@ -42,10 +42,11 @@ void readTrackingParams(ParamReader& r, Params* p)
     r.read(real.first, real.second);
   }
   const std::pair<const char*, int*> integers[] = {
-    { "tolerated_misses", &t.tolerated_misses },  { "max_misses", &t.max_misses },
-    { "lost_updates", &t.lost_updates },          { "max_hypotheses", &t.max_hypotheses },
-    { "tracking_max_seeds", &t.max_seeds },       { "global_interval", &p->global_interval },
-    { "conflict_readings", &t.conflict_readings }
+    { "tolerated_misses", &t.tolerated_misses },   { "max_misses", &t.max_misses },
+    { "lost_updates", &t.lost_updates },           { "max_hypotheses", &t.max_hypotheses },
+    { "tracking_max_seeds", &t.max_seeds },        { "global_interval", &p->global_interval },
+    { "conflict_readings", &t.conflict_readings }, { "confirm_searches", &t.confirm_searches },
+    { "history_batches", &t.history_batches }
   };
   for (const auto& integer : integers)
   {

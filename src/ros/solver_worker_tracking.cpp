@@ -92,11 +92,12 @@ bool SolverWorker::needsGlobalSearch(bool relocalizing) const
   // ~global_interval updates (some may still coast on odometry).
   const bool stuck =
       tracker_->failedUpdates() >= params_.global_interval && updates_since_global_ >= params_.global_interval;
+  // A place a search brought, otherwise clearly supported, waits for confirm_searches more.
   if (relocalizing || solveMode(params_) == SolveMode::Continuous)
   {
-    return empty_or_lost || stuck;
+    return empty_or_lost || stuck || tracker_->awaitingConfirmation();
   }
-  return false;
+  return tracker_->awaitingConfirmation();
 }
 
 void SolverWorker::startGlobalSearch(const Job& job)
@@ -112,7 +113,7 @@ void SolverWorker::startGlobalSearch(const Job& job)
   global_search_->readings = job.readings.size();
 }
 
-std::string SolverWorker::collectGlobalSearch(const Job& job)
+std::string SolverWorker::collectGlobalSearch()
 {
   if (!global_search_)
   {
@@ -120,12 +121,7 @@ std::string SolverWorker::collectGlobalSearch(const Job& job)
   }
   if (global_search_->result.wait_for(std::chrono::seconds(0)) != std::future_status::ready)
   {
-    std::vector<core::TrackerBatch>& since = global_search_->since;
-    if (since.size() >= kMaxCatchUp)
-    {
-      since.erase(since.begin());
-    }
-    since.push_back(core::TrackerBatch{ job.readings, job.batch.base_first });
+    global_search_->since = std::min<std::size_t>(global_search_->since + 1, core::kMaxCatchUp);
     return std::string();
   }
   PendingSearch search = std::move(*global_search_);
@@ -155,7 +151,7 @@ std::string SolverWorker::collectGlobalSearch(const Job& job)
                                             (", the best explains " + std::to_string(global.candidates[0].inliers) +
                                              " of " + std::to_string(search.readings) + " readings")
                                                 .c_str(),
-                global.times.total, global.truncated ? " (cut short: not seeded)" : "", search.since.size(),
+                global.times.total, global.truncated ? " (cut short: not seeded)" : "", search.since,
                 tracker_->hypotheses().size());
   return text;
 }
@@ -218,16 +214,14 @@ std::string SolverWorker::stepTracker(const Directive& directive, const Job& job
     {
       return applyHint(*directive.hint, job);
     }
-    const std::string event = collectGlobalSearch(job);
+    const std::string event = collectGlobalSearch();
     if (!global_search_ && needsGlobalSearch(directive.relocalizing))
     {
       startGlobalSearch(job);
     }
-    if (!tracker_->hypotheses().empty())
-    {
-      tracker_->update(job.readings, job.batch.base_first);
-      ++updates_since_global_;
-    }
+    // Every batch, with hypotheses or not: the tracker remembers it for the places a search brings.
+    updates_since_global_ += tracker_->hypotheses().empty() ? 0 : 1;
+    tracker_->update(job.readings, job.batch.base_first);
     return event;
   }
   catch (const std::exception& error)

@@ -174,7 +174,22 @@ inline core::TrackerOptions driveTrackerOptions()
   o.odom_alpha2 = 0.05;
   o.odom_alpha3 = 0.15;
   o.odom_alpha4 = 0.1;
+  // The drives seed the truth (or one global search's candidates) by hand: no later search
+  // confirms them (HypothesisTracker.TwinRoomsFromGlobalSearches runs the node's searches).
+  o.confirm_searches = 0;
   return o;
+}
+
+/// The node's tracking global search (SolverWorker::globalLocalizerFor): the adaptive engine at
+/// @p resolution cells and range tolerance @p tau [m], one thread as in the tracking launches.
+inline core::LocalizerOptions globalSearchOptions(int resolution, double tau)
+{
+  core::LocalizerOptions g;
+  g.engine = core::Engine::Adaptive;
+  g.resolution = resolution;
+  g.range_tolerance = tau;
+  g.threads = 1;
+  return g;
 }
 
 /// @p count people walking at random at @p speed [m/s], discs of @p radius [m].

@@ -96,11 +96,11 @@ private:
   bool needsGlobalSearch(bool relocalizing) const;
   /// Starts a global search on @p job's readings beside the tracking (global_search_).
   void startGlobalSearch(const Job& job);
-  /// Seeds the tracker with the candidates of a finished global search, carried through the
-  /// batches that came while it ran (before @p job); keeps @p job for that while it runs. The
-  /// event (empty: none finished, or it was for hypotheses dropped since by a relocalization
-  /// request).
-  std::string collectGlobalSearch(const Job& job);
+  /// Seeds the tracker with the candidates of a finished global search, its new places carried
+  /// through the batches the tracker remembered (those that came while it ran included); counts
+  /// one more such batch while it runs. The event (empty: none finished, or it was for
+  /// hypotheses dropped since by a relocalization request).
+  std::string collectGlobalSearch();
   /// Applies a pose hint to the tracker; the outcome as text.
   std::string applyHint(const PoseHint& hint, const Job& job);
   /// The hypotheses as a core::Result (poses at the batch's first reading), best first.
@@ -129,12 +129,10 @@ private:
     core::Pose2 reference;         ///< the odometry pose of the base its readings refer to
     std::uint64_t generation = 0;  ///< NodeState::generation it was started in
     std::size_t readings = 0;
-    /// The batches that came while it ran, oldest first (at most kMaxCatchUp: the newest)
-    std::vector<core::TrackerBatch> since;
+    /// Batches the tracker remembered after its batch (at most core::kMaxCatchUp, about 5 s at an
+    /// update every 0.05 s): its new places are carried through them (and those before).
+    std::size_t since = 0;
   };
-  /// Batches a finished global search's candidates are carried through at most (about 5 s at
-  /// an update every 0.05 s): they hold the worker for that many updates of each.
-  static constexpr std::size_t kMaxCatchUp = 100;
   std::optional<PendingSearch> global_search_;        ///< worker thread only
   std::unique_ptr<core::HypothesisTracker> tracker_;  ///< worker thread only; null until a map
   std::uint64_t generation_ = 0;                      ///< NodeState::generation of the last batch

@@ -14,11 +14,6 @@ namespace core
 {
 namespace
 {
-bool samePlace(const Pose2& a, const Pose2& b, double distance, double angle)
-{
-  return (a.position() - b.position()).norm() <= distance && std::abs(angleDiff(a.theta, b.theta)) <= angle;
-}
-
 std::string joined(const std::vector<std::string>& errors)
 {
   std::string text;
@@ -95,105 +90,22 @@ void HypothesisTracker::accumulateMotion(const Pose2& reference)
   have_reference_ = true;
 }
 
-void HypothesisTracker::seed(const std::vector<Candidate>& candidates, const Pose2& reference, double support)
+bool HypothesisTracker::samePlace(const Pose2& a, const Pose2& b) const
 {
-  if (!have_reference_)
-  {
-    last_reference_ = reference;
-    have_reference_ = true;
-  }
-  for (const Candidate& c : candidates)
-  {
-    const auto duplicate = std::find_if(hypotheses_.begin(), hypotheses_.end(), [&](const Hypothesis& h) {
-      return samePlace(compose(h.map_to_odom, reference), c.pose, options_.merge_distance, options_.merge_angle);
-    });
-    if (duplicate != hypotheses_.end())
-    {
-      duplicate->support = std::max(duplicate->support, support);
-      continue;
-    }
-    Hypothesis h;
-    h.id = next_id_++;
-    h.map_to_odom = compose(c.pose, inverse(reference));
-    h.support = support;
-    h.last_fix = c;
-    h.covariance = initialCovariance(c);
-    hypotheses_.push_back(std::move(h));
-  }
-  if (!candidates.empty())
-  {
-    failed_updates_ = 0;
-  }
-  prune();
-}
-
-void HypothesisTracker::seed(const std::vector<Candidate>& candidates, const Pose2& reference, double support,
-                             const std::vector<TrackerBatch>& since)
-{
-  if (since.empty() || candidates.empty())
-  {
-    seed(candidates, reference, support);
-    return;
-  }
-  // The others already stand at since.back(): the new ones catch up alone, then join them.
-  std::vector<Hypothesis> others;
-  others.swap(hypotheses_);
-  const int failed = failed_updates_;
-  last_reference_ = reference;
-  have_reference_ = true;
-  seed(candidates, reference, support);
-  for (const TrackerBatch& batch : since)
-  {
-    update(batch.readings, batch.reference);
-  }
-  hypotheses_.insert(hypotheses_.end(), std::make_move_iterator(others.begin()), std::make_move_iterator(others.end()));
-  failed_updates_ = std::min(failed, failed_updates_);
-  prune();
-}
-
-Eigen::Matrix3d HypothesisTracker::leastCovariance() const
-{
-  const Eigen::Vector3d floor(options_.box_min_xy / 3.0, options_.box_min_xy / 3.0, options_.box_min_theta / 3.0);
-  return floor.cwiseProduct(floor).asDiagonal();
-}
-
-Eigen::Matrix3d HypothesisTracker::initialCovariance(const Candidate& candidate) const
-{
-  // At least the smallest search box (as 3 sigma): a global search's polish may be overconfident.
-  const Eigen::Matrix3d least = leastCovariance();
-  const Eigen::Matrix3d& polished = candidate.covariance;
-  return polished.allFinite() && polished.diagonal().minCoeff() > 0.0 ? Eigen::Matrix3d(polished + least) : least;
-}
-
-HintOutcome HypothesisTracker::seedFromHint(const PoseBox& box, const std::vector<Reading>& readings,
-                                            const Pose2& reference)
-{
-  const int k = static_cast<int>(readings.size());
-  LocalSolveSettings settings = solveSettings(k);
-  // A hint's box may be metres wide: coarser leaves (at most 64 per axis) and more seeds.
-  settings.cell_xy = std::max(settings.cell_xy, std::max(box.x1 - box.x0, box.y1 - box.y0) / 64.0);
-  settings.cell_theta = std::max(settings.cell_theta, (box.t1 - box.t0) / 64.0);
-  settings.max_seeds = std::max(settings.max_seeds, 2 * options_.max_hypotheses);
-  settings.max_boxes = 2000000;
-  const BoxOccupancy coarse(*map_, settings.cell_xy);
-  const LocalSolveOutcome found = localSolve(*map_, coarse, readings, box, settings);
-  HintOutcome outcome;
-  outcome.min_consensus = settings.min_consensus;
-  outcome.best_consensus = found.best_consensus;
-  if (found.fixes.empty())
-  {
-    return outcome;
-  }
-  clear();
-  failed_updates_ = 0;
-  seed(found.fixes, reference, options_.min_support);
-  outcome.accepted = true;
-  outcome.hypotheses = static_cast<int>(hypotheses_.size());
-  return outcome;
+  return (a.position() - b.position()).norm() <= options_.merge_distance &&
+         std::abs(angleDiff(a.theta, b.theta)) <= options_.merge_angle;
 }
 
 UpdateReport HypothesisTracker::update(const std::vector<Reading>& readings, const Pose2& reference)
 {
+  if (!replaying_)
+  {
+    history_.push_back(TrackerBatch{ readings, reference });
+    while (history_.size() > static_cast<std::size_t>(options_.history_batches + 1 + kMaxCatchUp))
+    {
+      history_.pop_front();
+    }
+  }
   UpdateReport report;
   const int k = static_cast<int>(readings.size());
   const LocalSolveSettings settings = solveSettings(k);
@@ -327,8 +239,7 @@ int HypothesisTracker::prune()
   {
     const Pose2 pose = compose(h.map_to_odom, last_reference_);
     const bool duplicate = std::any_of(kept.begin(), kept.end(), [&](const Hypothesis& other) {
-      return samePlace(compose(other.map_to_odom, last_reference_), pose, options_.merge_distance,
-                       options_.merge_angle);
+      return samePlace(compose(other.map_to_odom, last_reference_), pose);
     });
     if (!duplicate && static_cast<int>(kept.size()) < options_.max_hypotheses)
     {
@@ -342,6 +253,7 @@ int HypothesisTracker::prune()
 void HypothesisTracker::clear()
 {
   hypotheses_.clear();
+  history_.clear();
   failed_updates_ = 0;
 }
 
@@ -354,7 +266,7 @@ void HypothesisTracker::restore(std::vector<Hypothesis> hypotheses)
   }
 }
 
-const Hypothesis* HypothesisTracker::clearlySupported() const
+const Hypothesis* HypothesisTracker::supportedUnconfirmed() const
 {
   if (hypotheses_.empty())
   {
@@ -366,6 +278,18 @@ const Hypothesis* HypothesisTracker::clearlySupported() const
                      best.support >= options_.min_support && best.support - second >= options_.support_margin &&
                      withinMargins(best.covariance);
   return clear ? &best : nullptr;
+}
+
+const Hypothesis* HypothesisTracker::clearlySupported() const
+{
+  const Hypothesis* best = supportedUnconfirmed();
+  return best && best->confirmations >= options_.confirm_searches ? best : nullptr;
+}
+
+bool HypothesisTracker::awaitingConfirmation() const
+{
+  const Hypothesis* best = supportedUnconfirmed();
+  return best && best->confirmations < options_.confirm_searches;
 }
 
 TrackState HypothesisTracker::state() const

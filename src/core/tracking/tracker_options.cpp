@@ -60,6 +60,10 @@ std::vector<std::string> validate(const TrackerOptions& o, const std::function<s
         o.direction_group, "[0, pi] rad, or < 0 (off)");
   check(in(o.fix_gate, 0.0, 1e6), "fix_gate", o.fix_gate, "[0, 1e6]");
   check(o.max_seeds >= 0 && o.max_seeds <= 100, "max_seeds", o.max_seeds, "an integer in [0, 100]");
+  check(o.confirm_searches >= 0 && o.confirm_searches <= 100, "confirm_searches", o.confirm_searches,
+        "an integer in [0, 100]");
+  check(o.history_batches >= 0 && o.history_batches <= 1000, "history_batches", o.history_batches,
+        "an integer in [0, 1000]");
   return errors;
 }
 

@@ -112,21 +112,18 @@ TEST(HypothesisTrackerBuilding, StartFromOneGlobalSearch)
   Drive drive(fdml_test::simulate(buildingDrive(), map), 10, 2);
   const core::TrackerOptions o = trackerOptions();
   core::HypothesisTracker tracker(map, o);
-  core::LocalizerOptions g;
-  g.engine = core::Engine::Adaptive;
-  g.resolution = 600;
-  g.range_tolerance = o.range_tolerance;
-  g.threads = 1;
-  core::Localizer global(map, g);
+  core::Localizer global(map, fdml_test::globalSearchOptions(600, o.range_tolerance));
   DriveBatch batch;
   ASSERT_TRUE(drive.next(&batch, 1.0));
+  tracker.update(batch.readings, batch.reference);  // remembered, as the node does every batch
   const core::Result first = global.localize(batch.readings);
   ASSERT_GT(first.candidates.size(), 1u) << "the start looks like other places";
   const core::Pose2 searched = batch.reference;
-  std::vector<core::TrackerBatch> meanwhile;
+  std::size_t meanwhile = 0;
   while (drive.next(&batch, 3.0))
   {
-    meanwhile.push_back(core::TrackerBatch{ batch.readings, batch.reference });
+    tracker.update(batch.readings, batch.reference);
+    ++meanwhile;
   }
   tracker.seed(first.candidates, searched, 0.0, meanwhile);
   int published = 0, wrong = 0, stalled = 0;

@@ -17,8 +17,9 @@
  * margins agrees with the fix (TrackerOptions::fix_gate); it is published only while within
  * those margins (publish_max_xy, publish_max_theta). A fix narrows a hypothesis whose 3 sigma
  * reaches beyond its (capped) box only when no other place of that 3-sigma region may explain
- * as many readings (onlyPlace()). A global search's candidates may join late:
- * seed() with the batches since carries them through those first.
+ * as many readings (onlyPlace()). A global search's candidates may join late, and places it
+ * missed may come with a later one: seed() carries new places through the remembered batches
+ * first, and a hypothesis a search brought is published only after confirm_searches more.
  */
 #pragma once
 
@@ -30,7 +31,9 @@
 
 #include <Eigen/Core>
 
+#include <cstddef>
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <string>
@@ -102,7 +105,26 @@ struct TrackerOptions
   /// are not independent: a filter taking each as new evidence would count every reading k / s
   /// times and grow overconfident (the node sets k / ~batch_stride).
   double fix_covariance_scale = 1.0;
+  /// A hypothesis a global search brought is published only after this many later global
+  /// searches were merged (seed()) while it stood: one search can miss places alike to it (a
+  /// continuum of poses holding several, a full candidate list), a later one may bring them.
+  /// The caller starts those searches while awaitingConfirmation(). A hint's hypotheses need
+  /// none. [0, 100]; 0 = publish without. Each costs a global search before a first fix, and
+  /// where look-alikes tie on the remembered readings (long corridors) it holds the fix until
+  /// the drive tells them apart: for maps with places alike (rooms), not the default.
+  int confirm_searches = 0;
+  /// Batches remembered before a global search's batch (update() remembers every batch): a new
+  /// place it brings is carried through them and those after it before it joins, starting from
+  /// the best hypothesis's support (what the best earned before them counts for both; what they
+  /// hold must tell the places apart). [0, 1000]; 0 = none (only the batches
+  /// since the search's). With confirm_searches: 16 in twin rooms; in the office drive 16 moved
+  /// the first fix from 23 to 31 s, so not the default.
+  int history_batches = 0;
 };
+
+/// Batches the tracker remembers after a global search's batch (seed()'s @p since): a search
+/// running that long loses the older ones' evidence.
+constexpr int kMaxCatchUp = 100;
 
 /// Every problem of @p options, as "NAME = VALUE is out of range; allowed: RANGE" (@p name maps
 /// an option's name to the caller's; empty = the option's own name).
@@ -125,8 +147,9 @@ struct Hypothesis
   /// direction moves neither the pose nor its claimed precision. The pose, its search box, the
   /// publishing rule and the published covariance follow it.
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  int fixes = 0;       ///< updates with a fix
-  Candidate last_fix;  ///< the last fix (pose of the base at its update's reference)
+  int fixes = 0;          ///< updates with a fix
+  Candidate last_fix;     ///< the last fix (pose of the base at its update's reference)
+  int confirmations = 0;  ///< global searches merged while it stood (TrackerOptions::confirm_searches)
 };
 
 /// The tracker's state.
@@ -174,21 +197,16 @@ public:
   HypothesisTracker(std::shared_ptr<const MapRayCaster> map, const TrackerOptions& options);
 
   /**
-   * @brief Adds a hypothesis per candidate (a global solve's), each with @p support, merged
-   *        with any existing one it duplicates (which keeps the larger support).
+   * @brief Merges a global search's candidates: one duplicating a hypothesis raises its support
+   *        to @p support at least; every other becomes a new hypothesis with the larger of
+   *        @p support and the best hypothesis's support, first carried through the remembered
+   *        batches (history_batches before the candidates' batch, that batch, and the @p since
+   *        batches remembered after it, oldest first) alone, then joining the others. Every
+   *        hypothesis that stood before counts one more confirmation.
    * @param reference the odometry pose of the base the candidates' poses refer to
+   * @param since batches update() remembered after the candidates' batch (at most kMaxCatchUp)
    */
-  void seed(const std::vector<Candidate>& candidates, const Pose2& reference, double support);
-
-  /**
-   * @brief seed(), the new hypotheses first carried through @p since (the batches that came
-   *        after the candidates' batch, oldest first, each the last reference of every existing
-   *        hypothesis in turn): a global search that ran for seconds loses none of the readings
-   *        that arrived meanwhile, and its places have earned support over them (or missed) when
-   *        they join the others.
-   */
-  void seed(const std::vector<Candidate>& candidates, const Pose2& reference, double support,
-            const std::vector<TrackerBatch>& since);
+  void seed(const std::vector<Candidate>& candidates, const Pose2& reference, double support, std::size_t since = 0);
 
   /**
    * @brief A user's hint: the poses in @p box (around the base at @p reference) that explain
@@ -198,7 +216,8 @@ public:
   HintOutcome seedFromHint(const PoseBox& box, const std::vector<Reading>& readings, const Pose2& reference);
 
   /// Re-solves every hypothesis over @p readings (relative to the base at odometry pose
-  /// @p reference) in its box around its prediction; updates support, merges, bounds.
+  /// @p reference) in its box around its prediction; updates support, merges, bounds. Remembers
+  /// the batch (seed()), with or without hypotheses: call it for every batch.
   UpdateReport update(const std::vector<Reading>& readings, const Pose2& reference);
 
   /// Drops every hypothesis (a relocalization).
@@ -212,8 +231,12 @@ public:
     return hypotheses_;
   }
   /// The clearly supported hypothesis (see TrackerOptions: min_support, support_margin,
-  /// tolerated_misses, conflict_readings, publish_max_xy, publish_max_theta), or null.
+  /// tolerated_misses, conflict_readings, publish_max_xy, publish_max_theta, confirm_searches),
+  /// or null.
   const Hypothesis* clearlySupported() const;
+  /// True when the best hypothesis would be clearly supported but for its confirmations: the
+  /// caller should run a global search and seed() its candidates.
+  bool awaitingConfirmation() const;
   TrackState state() const;
   /// Updates in a row in which no hypothesis had a fix (0 after a fix).
   int failedUpdates() const
@@ -257,6 +280,19 @@ private:
   bool withinMargins(const Eigen::Matrix3d& covariance) const;
   /// Merges duplicates, drops hypotheses that missed too often, sorts, bounds the count.
   int prune();
+  /// True when poses @p a and @p b are within merge_distance and merge_angle.
+  bool samePlace(const Pose2& a, const Pose2& b) const;
+  /// The best hypothesis when it meets every publishing condition but confirm_searches, or null.
+  const Hypothesis* supportedUnconfirmed() const;
+  /// Adds a hypothesis per candidate not duplicating one (whose support rises to @p support),
+  /// with @p support, @p confirmations and initialCovariance() plus @p spread.
+  void add(const std::vector<Candidate>& candidates, const Pose2& reference, double support, int confirmations,
+           const Eigen::Matrix3d& spread);
+  /// Carries the hypotheses alone through remembered batches [@p first, end) (nothing remembered).
+  void replay(std::size_t first);
+  /// The odometry noise (as a covariance [m^2, rad^2]) of the motion over remembered batches
+  /// [@p first, @p last).
+  Eigen::Matrix3d replaySpread(std::size_t first, std::size_t last) const;
 
   std::shared_ptr<const MapRayCaster> map_;
   TrackerOptions options_;
@@ -266,6 +302,8 @@ private:
   Pose2 last_reference_;
   int failed_updates_ = 0;
   std::uint64_t next_id_ = 1;
+  std::deque<TrackerBatch> history_;  ///< the last batches updated, oldest first (seed())
+  bool replaying_ = false;            ///< update() carries new hypotheses: remember nothing
 };
 
 }  // namespace core

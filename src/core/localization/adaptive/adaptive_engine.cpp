@@ -2,6 +2,7 @@
 // shared robust search (seed_search.h), or verified component centres (paper, baseline).
 #include "fdml_localization/core/localization/adaptive/adaptive_engine.h"
 
+#include "fdml_localization/core/localization/adaptive/region_fill.h"
 #include "fdml_localization/core/localization/certificate.h"
 #include "fdml_localization/core/localization/ranking.h"
 #include "fdml_localization/core/localization/region_starts.h"
@@ -23,8 +24,6 @@ namespace
 {
 /// Leaves at the bound (spread over them) whose lattice searchNoReturnRegion() verifies.
 constexpr std::size_t kNoReturnScanLeaves = 512;
-/// Lattice points per axis inside each such leaf.
-constexpr int kNoReturnLattice = 3;
 /// The best lattice poses (one per leaf) refined.
 constexpr std::size_t kNoReturnRefined = 4;
 /// Leaves of a plateau (spread over it) the final multi-start polishes from.
@@ -151,41 +150,6 @@ private:
   bool truncated_ = false;
 };
 
-/// The best-verified pose of a lattice in each leaf reaching @p bound (at most
-/// kNoReturnScanLeaves leaves, spread over them).
-std::vector<Candidate> leafLatticeBests(const MapRayCaster& map, const std::vector<LeafBox>& leaves, int bound,
-                                        const std::vector<Reading>& readings, double eps)
-{
-  std::vector<const LeafBox*> at_bound;
-  for (const LeafBox& leaf : leaves)
-  {
-    if (leaf.count >= bound)
-    {
-      at_bound.push_back(&leaf);
-    }
-  }
-  const std::size_t step = std::max<std::size_t>(1, at_bound.size() / kNoReturnScanLeaves);
-  std::vector<Candidate> lattice_best;
-  for (std::size_t l = 0; l < at_bound.size(); l += step)
-  {
-    const PoseBox& b = at_bound[l]->box;
-    Candidate leaf_best;
-    leaf_best.inliers = -1;
-    for (int i = 0; i < kNoReturnLattice * kNoReturnLattice * kNoReturnLattice; ++i)
-    {
-      const auto at = [](double lo, double hi, int j) { return lo + (hi - lo) * (j + 0.5) / kNoReturnLattice; };
-      const Pose2 pose(at(b.x0, b.x1, i % kNoReturnLattice), at(b.y0, b.y1, (i / kNoReturnLattice) % kNoReturnLattice),
-                       at(b.t0, b.t1, i / (kNoReturnLattice * kNoReturnLattice)));
-      Candidate c = verifiedCandidate(map, pose, readings, eps);
-      if (leaf_best.inliers < 0 || betterCandidate(c, leaf_best))
-      {
-        leaf_best = std::move(c);
-      }
-    }
-    lattice_best.push_back(std::move(leaf_best));
-  }
-  return lattice_best;
-}
 }  // namespace
 
 Result AdaptiveEngine::localize(const std::vector<Reading>& readings)
@@ -262,6 +226,19 @@ void AdaptiveEngine::localizeRobust(AdaptiveSearch& search, const std::vector<Re
   result.min_inliers_used = found.min_inliers_used;
   result.candidates = std::move(found.candidates);
   searchNoReturnRegion(search, readings, result);
+  const auto stage = std::chrono::steady_clock::now();
+  fillUncoveredRegions(*map_, search.result().leaves, readings, options_, latticeRefinement(), result);
+  result.times.polish += secondsSince(stage);
+}
+
+RefinementSettings AdaptiveEngine::latticeRefinement() const
+{
+  RefinementSettings settings;
+  settings.agreement_tolerance = options_.agreement_tolerance;
+  settings.robust_scale = std::max(options_.agreement_tolerance, cell_xy_);
+  settings.seed_position_error = cell_xy_;
+  settings.seed_angle_error = cell_theta_;
+  return settings;
 }
 
 void AdaptiveEngine::searchNoReturnRegion(const AdaptiveSearch& search, const std::vector<Reading>& readings,
@@ -279,16 +256,20 @@ void AdaptiveEngine::searchNoReturnRegion(const AdaptiveSearch& search, const st
   {
     return;
   }
+  std::vector<const LeafBox*> at_bound;
+  for (const LeafBox& leaf : search.result().leaves)
+  {
+    if (leaf.count >= bound)
+    {
+      at_bound.push_back(&leaf);
+    }
+  }
   std::vector<Candidate> lattice_best =
-      leafLatticeBests(*map_, search.result().leaves, bound, readings, options_.agreement_tolerance);
+      leafLatticeBests(*map_, at_bound, kNoReturnScanLeaves, readings, options_.agreement_tolerance);
   const std::size_t refined = std::min(kNoReturnRefined, lattice_best.size());
   std::partial_sort(lattice_best.begin(), lattice_best.begin() + static_cast<std::ptrdiff_t>(refined),
                     lattice_best.end(), betterCandidate);
-  RefinementSettings settings;
-  settings.agreement_tolerance = options_.agreement_tolerance;
-  settings.robust_scale = std::max(options_.agreement_tolerance, cell_xy_);
-  settings.seed_position_error = cell_xy_;
-  settings.seed_angle_error = cell_theta_;
+  const RefinementSettings settings = latticeRefinement();
   Candidate found = best;
   for (std::size_t i = 0; i < refined; ++i)
   {

@@ -10,6 +10,7 @@
 #include "fdml_localization/core/localization/adaptive/adaptive_search.h"
 #include "fdml_localization/core/localization/adaptive/leaf_clustering.h"
 #include "fdml_localization/core/localization/localizer.h"
+#include "fdml_localization/core/localization/robust_search.h"
 
 #include <memory>
 #include <vector>
@@ -45,6 +46,9 @@ private:
   /// added when it beats the best candidate. The polish moves poses by finite ranges only, so a
   /// region that no-return readings shape is searched rather than polished.
   void searchNoReturnRegion(const AdaptiveSearch& search, const std::vector<Reading>& readings, Result& result) const;
+  /// The refinement of a lattice pose (searchNoReturnRegion(), fillUncoveredRegions()): seeds one
+  /// leaf from the optimum.
+  RefinementSettings latticeRefinement() const;
 
   std::shared_ptr<const MapRayCaster> map_;
   LocalizerOptions options_;

@@ -1,0 +1,47 @@
+/**
+ * @file region_fill.h
+ * @brief The adaptive engine's last look at the places its seeds missed (issue 16): the leaves
+ *        reaching the best candidate's consensus that no candidate accounts for are searched with
+ *        a lattice of exactly verified poses, refined; a pose explaining as many readings as the
+ *        best candidate joins the candidates. Where the readings leave a continuum (few finite
+ *        ranges, alike rooms), one region of leaves can hold several places and the seeds' polish
+ *        reaches some and not others; this finds the rest.
+ */
+#pragma once
+
+#include "fdml_localization/core/localization/adaptive/adaptive_search.h"
+#include "fdml_localization/core/localization/localizer.h"
+#include "fdml_localization/core/localization/robust_search.h"
+
+#include <cstddef>
+#include <vector>
+
+namespace fdml_localization
+{
+namespace core
+{
+/// Lattice points per axis inside each leaf leafLatticeBests() verifies.
+constexpr int kLeafLattice = 3;
+
+/**
+ * @brief The best exactly verified pose (agreement band @p eps [m]) of a kLeafLattice^3 lattice
+ *        in each of @p leaves, at most @p max_leaves of them spread evenly over the list.
+ */
+std::vector<Candidate> leafLatticeBests(const MapRayCaster& map, const std::vector<const LeafBox*>& leaves,
+                                        std::size_t max_leaves, const std::vector<Reading>& readings, double eps);
+
+/**
+ * @brief Adds to @p result (ranked, de-duplicated, at most max_candidates) the places its
+ *        candidates miss: among @p leaves reaching the best candidate's net consensus, those no
+ *        candidate accounts for (its pose within the uniqueness margins of the leaf, or the leaf's
+ *        centre within 3 sigma of its covariance), the best centre poses first, get a lattice
+ *        search refined with @p settings; a pose reaching that consensus joins and accounts for
+ *        the leaves around it. At most kFillTries leaves are searched.
+ * @return the leaves searched
+ */
+int fillUncoveredRegions(const MapRayCaster& map, const std::vector<LeafBox>& leaves,
+                         const std::vector<Reading>& readings, const LocalizerOptions& options,
+                         const RefinementSettings& settings, Result& result);
+
+}  // namespace core
+}  // namespace fdml_localization

@@ -79,13 +79,6 @@ struct BoundRegions
   std::vector<int> region;  ///< per box
 };
 
-bool contains(const PoseBox& b, const Pose2& q)
-{
-  const double t = b.t0 + std::remainder(q.theta - b.t0, kTwoPi);
-  return q.x >= b.x0 && q.x <= b.x1 && q.y >= b.y0 && q.y <= b.y1 &&
-         ((t >= b.t0 && t <= b.t1) || (t + kTwoPi >= b.t0 && t + kTwoPi <= b.t1));
-}
-
 /// Fills @p result.certificate: covered regions hold a candidate's pose; the others are
 /// excluded when no sub-box of theirs may reach the bound.
 void certify(const MapRayCaster& map, const std::vector<Reading>& readings, double tolerance, int bound,
@@ -101,7 +94,7 @@ void certify(const MapRayCaster& map, const std::vector<Reading>& readings, doub
   {
     for (const Candidate& candidate : result.candidates)
     {
-      covered[static_cast<std::size_t>(regions.region[b])] |= contains(regions.boxes[b], candidate.pose) ? 1 : 0;
+      covered[static_cast<std::size_t>(regions.region[b])] |= regions.boxes[b].contains(candidate.pose) ? 1 : 0;
     }
   }
   c.regions_covered = static_cast<int>(std::count(covered.begin(), covered.end(), 1));

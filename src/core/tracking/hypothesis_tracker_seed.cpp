@@ -11,6 +11,14 @@ namespace fdml_localization
 {
 namespace core
 {
+Hypothesis* HypothesisTracker::holding(const Pose2& pose, const Pose2& reference)
+{
+  const auto found = std::find_if(hypotheses_.begin(), hypotheses_.end(), [&](const Hypothesis& h) {
+    return samePlace(compose(h.map_to_odom, reference), pose);
+  });
+  return found == hypotheses_.end() ? nullptr : &*found;
+}
+
 void HypothesisTracker::add(const std::vector<Candidate>& candidates, const Pose2& reference, double support,
                             int confirmations, const Eigen::Matrix3d& spread)
 {
@@ -21,10 +29,7 @@ void HypothesisTracker::add(const std::vector<Candidate>& candidates, const Pose
   }
   for (const Candidate& c : candidates)
   {
-    const auto duplicate = std::find_if(hypotheses_.begin(), hypotheses_.end(), [&](const Hypothesis& h) {
-      return samePlace(compose(h.map_to_odom, reference), c.pose);
-    });
-    if (duplicate != hypotheses_.end())
+    if (Hypothesis* duplicate = holding(c.pose, reference))
     {
       duplicate->support = std::max(duplicate->support, support);
       continue;
@@ -46,16 +51,14 @@ void HypothesisTracker::seed(const std::vector<Candidate>& candidates, const Pos
   std::vector<Candidate> fresh;
   for (const Candidate& c : candidates)
   {
-    const auto duplicate = std::find_if(hypotheses_.begin(), hypotheses_.end(), [&](const Hypothesis& h) {
-      return samePlace(compose(h.map_to_odom, reference), c.pose);
-    });
-    if (duplicate == hypotheses_.end())
+    Hypothesis* duplicate = holding(c.pose, reference);
+    if (duplicate)
     {
-      fresh.push_back(c);
+      duplicate->support = std::max(duplicate->support, support);
     }
     else
     {
-      duplicate->support = std::max(duplicate->support, support);
+      fresh.push_back(c);
     }
   }
   double best = 0.0;

@@ -282,6 +282,8 @@ private:
   int prune();
   /// True when poses @p a and @p b are within merge_distance and merge_angle.
   bool samePlace(const Pose2& a, const Pose2& b) const;
+  /// The hypothesis whose pose of the base at @p reference is samePlace() as @p pose, or null.
+  Hypothesis* holding(const Pose2& pose, const Pose2& reference);
   /// The best hypothesis when it meets every publishing condition but confirm_searches, or null.
   const Hypothesis* supportedUnconfirmed() const;
   /// Adds a hypothesis per candidate not duplicating one (whose support rises to @p support),

@@ -15,7 +15,8 @@ namespace core
 {
 namespace
 {
-/// Leaves without a candidate (spread over them) whose centre pose is verified.
+/// Leaves at the best consensus (spread over them) checked; those no candidate accounts for
+/// get their centre pose verified ...
 constexpr std::size_t kFillLeaves = 20000;
 /// ... whose lattice is searched, the best centres first, when the centre explains at most this
 /// many readings fewer than the best candidate ...
@@ -26,31 +27,58 @@ constexpr int kFillTries = 16;
 /// 3 degrees of freedom, 99 %).
 constexpr double kChiSquare3Dof = 11.34;
 
-/// True when @p pose lies in @p box grown by @p margin [m] and @p angle [rad] (theta periodic).
-bool nearBox(const PoseBox& box, const Pose2& pose, double margin, double angle)
+/// What candidates account for: a leaf box holding a candidate's pose within the uniqueness
+/// margins, or whose centre lies within 3 sigma of the candidate's covariance grown by the leaf's
+/// size (a continuum). The grown covariance is factorised once per candidate and leaf size.
+class Accounting
 {
-  const double t = box.t0 + std::remainder(pose.theta - box.t0, kTwoPi);
-  const auto within = [&](double a) { return a >= box.t0 - angle && a <= box.t1 + angle; };
-  return pose.x >= box.x0 - margin && pose.x <= box.x1 + margin && pose.y >= box.y0 - margin &&
-         pose.y <= box.y1 + margin && (within(t) || within(t + kTwoPi) || within(t - kTwoPi));
-}
+public:
+  explicit Accounting(const LocalizerOptions& options) : options_(options)
+  {}
 
-/// True when @p candidate accounts for the poses of @p box: its pose near the box
-/// (uniqueness margins), or the box's centre within its covariance's 3 sigma (a continuum).
-bool accountsFor(const Candidate& candidate, const PoseBox& box, const LocalizerOptions& options, double cell_xy,
-                 double cell_theta)
-{
-  if (nearBox(box, candidate.pose, options.uniqueness_distance, options.uniqueness_angle))
+  void add(const Candidate& candidate)
   {
-    return true;
+    // Factorised here too so that it is never read uninitialised; a leaf size replaces it.
+    entries_.push_back(
+        Entry{ candidate.pose, candidate.covariance, Eigen::LDLT<Eigen::Matrix3d>(candidate.covariance), -1.0, -1.0 });
   }
-  const Pose2 centre(0.5 * (box.x0 + box.x1), 0.5 * (box.y0 + box.y1), 0.5 * (box.t0 + box.t1));
-  const Eigen::Vector3d d = poseDifference(centre, candidate.pose);
-  const Eigen::Matrix3d spread =
-      candidate.covariance +
-      Eigen::Vector3d(cell_xy * cell_xy, cell_xy * cell_xy, cell_theta * cell_theta).asDiagonal().toDenseMatrix();
-  return d.dot(spread.ldlt().solve(d)) <= kChiSquare3Dof;
-}
+
+  bool accountsFor(const PoseBox& box)
+  {
+    const double cx = box.x1 - box.x0, ct = box.t1 - box.t0;
+    const Pose2 centre = box.centre();
+    for (Entry& e : entries_)
+    {
+      if (box.contains(e.pose, options_.uniqueness_distance, options_.uniqueness_angle))
+      {
+        return true;
+      }
+      if (cx != e.cell_xy || ct != e.cell_theta)
+      {
+        e.cell_xy = cx;
+        e.cell_theta = ct;
+        e.spread.compute(e.covariance + Eigen::Vector3d(cx * cx, cx * cx, ct * ct).asDiagonal().toDenseMatrix());
+      }
+      const Eigen::Vector3d d = poseDifference(centre, e.pose);
+      if (d.dot(e.spread.solve(d)) <= kChiSquare3Dof)
+      {
+        return true;
+      }
+    }
+    return false;
+  }
+
+private:
+  struct Entry
+  {
+    Pose2 pose;
+    Eigen::Matrix3d covariance;
+    Eigen::LDLT<Eigen::Matrix3d> spread;  ///< of covariance + the leaf size below, squared
+    double cell_xy, cell_theta;           ///< [m], [rad]
+  };
+  const LocalizerOptions& options_;
+  std::vector<Entry> entries_;
+};
 
 /// A leaf no candidate accounts for, with its centre pose's net consensus.
 struct OpenLeaf
@@ -65,6 +93,11 @@ std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<Leaf
                                  const std::vector<Reading>& readings, const std::vector<Candidate>& candidates,
                                  const LocalizerOptions& options)
 {
+  Accounting accounting(options);
+  for (const Candidate& c : candidates)
+  {
+    accounting.add(c);
+  }
   std::vector<const LeafBox*> reaching;
   for (const LeafBox& leaf : leaves)
   {
@@ -78,13 +111,11 @@ std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<Leaf
   for (std::size_t l = 0; l < reaching.size(); l += step)
   {
     const PoseBox& b = reaching[l]->box;
-    if (std::any_of(candidates.begin(), candidates.end(),
-                    [&](const Candidate& c) { return accountsFor(c, b, options, b.x1 - b.x0, b.t1 - b.t0); }))
+    if (accounting.accountsFor(b))
     {
       continue;
     }
-    const Pose2 centre(0.5 * (b.x0 + b.x1), 0.5 * (b.y0 + b.y1), 0.5 * (b.t0 + b.t1));
-    Candidate c = verifiedCandidate(map, centre, readings, options.agreement_tolerance);
+    Candidate c = verifiedCandidate(map, b.centre(), readings, options.agreement_tolerance);
     if (netConsensus(c) >= target - kCentreSlack)
     {
       open.push_back(OpenLeaf{ reaching[l], std::move(c) });
@@ -147,12 +178,11 @@ int fillUncoveredRegions(const MapRayCaster& map, const std::vector<LeafBox>& le
   const int target = netConsensus(result.candidates.front());
   const std::vector<OpenLeaf> open = openLeaves(map, leaves, target, readings, result.candidates, options);
   std::vector<Candidate> added;
+  Accounting found(options);  // the open leaves' places found so far
   int tried = 0;
   for (std::size_t i = 0; i < open.size() && tried < kFillTries; ++i)
   {
-    const PoseBox& b = open[i].leaf->box;
-    const double cx = b.x1 - b.x0, ct = b.t1 - b.t0;
-    if (std::any_of(added.begin(), added.end(), [&](const Candidate& c) { return accountsFor(c, b, options, cx, ct); }))
+    if (found.accountsFor(open[i].leaf->box))
     {
       continue;
     }
@@ -162,6 +192,7 @@ int fillUncoveredRegions(const MapRayCaster& map, const std::vector<LeafBox>& le
     {
       place.support = 1.0;
       widenAlongContinua(map, readings, settings.noise_sigma, place);
+      found.add(place);
       added.push_back(std::move(place));
     }
   }

@@ -18,6 +18,7 @@
 #include "fdml_localization/core/localization/localizer.h"
 
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -36,6 +37,16 @@ struct PoseBox
   Pose2 centre() const
   {
     return Pose2(0.5 * (x0 + x1), 0.5 * (y0 + y1), wrapAngle(0.5 * (t0 + t1)));
+  }
+
+  /// True when @p q lies in the box grown by @p margin [m] in x, y and @p angle [rad] in theta
+  /// (theta periodic).
+  bool contains(const Pose2& q, double margin = 0.0, double angle = 0.0) const
+  {
+    const double t = t0 + std::remainder(q.theta - t0, kTwoPi);
+    const auto within = [&](double a) { return a >= t0 - angle && a <= t1 + angle; };
+    return q.x >= x0 - margin && q.x <= x1 + margin && q.y >= y0 - margin && q.y <= y1 + margin &&
+           (within(t) || within(t + kTwoPi) || within(t - kTwoPi));
   }
 };
 

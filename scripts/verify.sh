@@ -3,10 +3,16 @@
 # random trials over reading geometries on small maps, both engines, noise-free and noisy,
 # checked against the truth and a sampled reference; prints the figures (docs/BENCHMARKS.md).
 #   VERIFY_TRIALS=N VERIFY_MINUTES=M   override the default 10,000 trials or 15 minutes
+#   VERIFY_MAPS="a.poly b.poly"        verify on these polygon maps instead of the small ones
+#   VERIFY_RESOLUTION=N                the engines' resolution (default 64)
 set -euo pipefail
 source "$(dirname "$0")/common.sh"
 catkin_build verify_localization
 cd "$REPO_DIR"
 echo "== verify_localization ($(nproc) cores, $(date -u +%Y-%m-%dT%H:%MZ), load: $(cut -d' ' -f1-3 /proc/loadavg))"
+map_args=()
+for map in ${VERIFY_MAPS:-}; do
+  map_args+=(--map "$map")
+done
 "$WS/devel/lib/fdml_localization/verify_localization" --trials "${VERIFY_TRIALS:-10000}" \
-  --minutes "${VERIFY_MINUTES:-15}"
+  --minutes "${VERIFY_MINUTES:-15}" --resolution "${VERIFY_RESOLUTION:-64}" "${map_args[@]}"

@@ -1,6 +1,8 @@
 #include "fdml_localization/core/geometry/geometry.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 namespace fdml_localization
 {
@@ -199,17 +201,43 @@ double pointSegmentDistanceSquared(const Vec2& p, const Segment& seg)
   return (closestPointOnSegment(p, seg) - p).squaredNorm();
 }
 
-bool crossesRightOf(const Vec2& p, const Vec2& a, const Vec2& b)
+double horizontalCrossingX(double y, const Vec2& a, const Vec2& b)
 {
-  if ((a.y() > p.y()) == (b.y() > p.y()))
+  if ((a.y() > y) == (b.y() > y))
   {
-    return false;
+    return std::numeric_limits<double>::quiet_NaN();
   }
   // Canonical order (lower y first) so that the result does not depend on the edge's direction.
   const Vec2& lo = a.y() < b.y() ? a : b;
   const Vec2& hi = a.y() < b.y() ? b : a;
-  const double x = lo.x() + (p.y() - lo.y()) * (hi.x() - lo.x()) / (hi.y() - lo.y());
-  return p.x() < x;
+  return lo.x() + (y - lo.y()) * (hi.x() - lo.x()) / (hi.y() - lo.y());
+}
+
+bool crossesRightOf(const Vec2& p, const Vec2& a, const Vec2& b)
+{
+  return p.x() < horizontalCrossingX(p.y(), a, b);  // false for NaN
+}
+
+Crossing segmentCrossing(const Vec2& p, const Vec2& q, const Vec2& a, const Vec2& b, double tolerance)
+{
+  // Each orientation is a signed distance times the length of the segment it is taken against.
+  const double ab = (b - a).norm();
+  const double pq = (q - p).norm();
+  const double o1 = cross(b - a, p - a);
+  const double o2 = cross(b - a, q - a);
+  const double o3 = cross(q - p, a - p);
+  const double o4 = cross(q - p, b - p);
+  if (std::abs(o1) <= tolerance * ab || std::abs(o2) <= tolerance * ab || std::abs(o3) <= tolerance * pq ||
+      std::abs(o4) <= tolerance * pq)
+  {
+    // An end near the other's line: degenerate when their boxes, grown by the tolerance, meet.
+    const bool apart = std::max(p.x(), q.x()) + tolerance < std::min(a.x(), b.x()) ||
+                       std::max(a.x(), b.x()) + tolerance < std::min(p.x(), q.x()) ||
+                       std::max(p.y(), q.y()) + tolerance < std::min(a.y(), b.y()) ||
+                       std::max(a.y(), b.y()) + tolerance < std::min(p.y(), q.y());
+    return apart ? Crossing::None : Crossing::Degenerate;
+  }
+  return ((o1 > 0.0) != (o2 > 0.0) && (o3 > 0.0) != (o4 > 0.0)) ? Crossing::Proper : Crossing::None;
 }
 
 bool pointInRing(const Vec2& p, const Ring& ring)

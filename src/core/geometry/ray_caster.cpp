@@ -39,6 +39,7 @@ SegmentGrid::SegmentGrid(std::vector<Segment> segments, double cell_size) : segm
   ny_ = std::max(1, static_cast<int>(std::ceil(size.y() / cell_)));
 
   buildCells();
+  buildCentreParity();
 }
 
 template <typename Fn>
@@ -319,7 +320,7 @@ bool MapRayCaster::isFree(const Vec2& p) const
   {
     return false;
   }
-  return (grid_.crossingsToRight(p) % 2) == 1;
+  return grid_.oddCrossingsToRight(p);
 }
 
 }  // namespace core

@@ -67,6 +67,32 @@ Pose2 freeStart(const MapRayCaster& map, const Pose2& start, double reach)
   return Pose2(best.x(), best.y(), start.theta);
 }
 
+double agreementScore(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings, double gate)
+{
+  double score = 0.0;
+  for (const Reading& reading : readings)
+  {
+    const Pose2 sensor = compose(pose, reading.offset);
+    double cost = gate * gate;
+    if (map.isFree(sensor.position()))
+    {
+      // A cast need not look beyond where the reading could still agree: the same verdicts
+      // and residuals as evaluatePose(), for much shorter casts where the map reaches far.
+      if (std::isfinite(reading.range))
+      {
+        const double r = predictedRange(map, sensor, reading, reading.range + gate) - reading.range;
+        cost = std::abs(r) < gate ? r * r : cost;
+      }
+      else if (predictedRange(map, sensor, reading, reading.max_range + 1.0) > reading.max_range - gate)
+      {
+        cost = 0.0;
+      }
+    }
+    score += cost;
+  }
+  return score;
+}
+
 std::vector<Pose2> bestAgreeingPoses(const MapRayCaster& map, const std::vector<Pose2>& poses,
                                      const std::vector<Reading>& readings, double gate, double separation_xy,
                                      double separation_theta, std::size_t max_poses, std::size_t sampled)
@@ -77,16 +103,7 @@ std::vector<Pose2> bestAgreeingPoses(const MapRayCaster& map, const std::vector<
   for (std::size_t s = 0; s < samples; ++s)
   {
     const Pose2 pose = freeStart(map, poses[s * n / samples], 0.5 * separation_xy);
-    const PoseEvaluation e = evaluatePose(map, pose, readings, gate);
-    double score = static_cast<double>(readings.size() - e.inliers) * gate * gate;
-    for (std::size_t i = 0; i < readings.size(); ++i)
-    {
-      if (e.inlier_mask[i] && std::isfinite(e.residuals[i]))
-      {
-        score += e.residuals[i] * e.residuals[i];
-      }
-    }
-    scored.emplace_back(score, pose);
+    scored.emplace_back(agreementScore(map, pose, readings, gate), pose);
   }
   std::stable_sort(
       scored.begin(), scored.end(),

@@ -21,6 +21,8 @@ namespace
 constexpr std::size_t kRetriedSeeds = 32;
 /// ... of which this many first get a local lattice search around their start.
 constexpr std::size_t kLocallySearchedSeeds = 8;
+/// Optima of one multi-start closer than this [m] and [rad] are one optimum.
+constexpr double kSameOptimum = 1e-3;
 
 /// What refining a seed needs.
 struct SearchContext
@@ -235,12 +237,17 @@ private:
         kept[j] = std::move(polished);
       }
       widenAlongContinua(ctx_.map, ctx_.readings, ctx_.settings.noise_sigma, kept[j]);
-      ties[j] = rankAndDeduplicate(std::move(ties[j]), options.uniqueness_distance, options.uniqueness_angle,
-                                   options.max_candidates);
+      // Distinct optima: a tie within the uniqueness margins of kept[j] is dropped as its
+      // duplicate only after it widened kept[j]'s covariance (absorbTiedDuplicates()).
+      ties[j] = rankAndDeduplicate(std::move(ties[j]), kSameOptimum, kSameOptimum, options.max_candidates);
       for (Candidate& tie : ties[j])
       {
         tie.support = kept[j].support;
-        widenAlongContinua(ctx_.map, ctx_.readings, ctx_.settings.noise_sigma, tie);
+        const Eigen::Vector3d d = poseDifference(tie.pose, kept[j].pose);
+        if (d.head<2>().norm() >= options.uniqueness_distance || std::abs(d.z()) >= options.uniqueness_angle)
+        {
+          widenAlongContinua(ctx_.map, ctx_.readings, ctx_.settings.noise_sigma, tie);
+        }
       }
     }
     for (std::vector<Candidate>& found : ties)

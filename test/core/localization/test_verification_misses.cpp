@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <sstream>
+#include <utility>
 
 namespace fdml_localization
 {
@@ -94,6 +95,9 @@ const char* const kPastMisses[] = {
   // verify --seed 4, voxel: the right sensor grazes a vertex at the truth, whose heading mirrored about
   // the front wall's normal explains all twelve readings within 2.7 mm; the polish stopped there.
   "driving map 0 k 12 exact truth (0.4730370896, 1.2986776573, 1.6251587389)",
+  // verify --seed 4, adaptive, replayed bit-exact (17 digits) in the eighth round.
+  "no-return map 2 k 4 exact truth (-0.024354902246754073, 0.021091898507251905, 0.82558870032436937) max range "
+  "1.4895889303457082",
 };
 
 class PastMisses : public ::testing::TestWithParam<Engine>
@@ -112,6 +116,43 @@ TEST_P(PastMisses, TheTruthIsAmongTheCandidates)
     for (const std::string& failure : figures.failures)
     {
       ADD_FAILURE() << failure;
+    }
+  }
+}
+
+/// `verify_localization --seed 12 --map` on the bundled apartment, office, warehouse, corridor and
+/// twin rooms (map 0 to 4), adaptive engine: places alike enough to explain every reading exactly
+/// in other rooms, the truth's region of leaves never searched (eighth round), at the resolution
+/// given.
+const std::pair<const char*, int> kBundledMapMisses[] = {
+  { "driving map 0 k 8 exact truth (8.2526983011685893, 7.9334442982228222, -2.6402727739307008)", 64 },
+  { "driving map 1 k 5 exact truth (10.873324094953373, 5.3714532246066442, 2.1507186343062079)", 64 },
+  { "driving map 3 k 12 exact truth (14.52162645313294, 2.4828448413602198, -0.96253437142145559)", 64 },
+  { "driving map 4 k 19 exact truth (7.7301696225905774, 2.2502353844054599, -0.87505177060145778)", 64 },
+  // Its first leaf's lattice refined to 18 of 19 readings 20 cm off: the region's next leaves.
+  { "driving map 4 k 19 exact truth (7.7301696225905774, 2.2502353844054599, -0.87505177060145778)", 100 },
+};
+
+TEST(PastMissesOnBundledMaps, TheAdaptiveEngineSearchesEveryRegionReachingTheConsensus)
+{
+  std::vector<std::shared_ptr<const MapRayCaster>> maps;
+  for (const char* name : { "apartment", "office", "warehouse", "corridor", "twin_rooms" })
+  {
+    maps.push_back(test::loadMap(std::string("maps/") + name + ".poly"));
+  }
+  for (const auto& miss : kBundledMapMisses)
+  {
+    const verification::Trial trial = trialFrom(miss.first, maps);
+    LocalizerOptions options;
+    options.engine = Engine::Adaptive;
+    options.resolution = miss.second;
+    options.threads = 1;
+    Localizer localizer(maps[static_cast<std::size_t>(trial.map)], options);
+    verification::Figures figures;
+    verification::checkNoiseFree(localizer, trial, localizer.localize(trial.readings), miss.first, figures);
+    for (const std::string& failure : figures.failures)
+    {
+      ADD_FAILURE() << "resolution " << miss.second << ": " << failure;
     }
   }
 }

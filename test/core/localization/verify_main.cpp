@@ -2,8 +2,11 @@
 // given time (default 10,000 or 15 minutes), both engines; prints the figures per engine and
 // per geometry and every failure; exits 1 when the truth was missed in a noise-free trial or a
 // certificate was contradicted.
-//   verify_localization [--trials N] [--minutes M] [--seed S] [--resolution N]
+//   verify_localization [--trials N] [--minutes M] [--seed S] [--resolution N] [--map FILE.poly ...]
+// --map (repeatable) verifies on those polygon maps instead of the three small built-in ones.
 #include "verification_trials.h"
+
+#include "fdml_localization/core/map/map_io.h"
 
 #include <chrono>
 #include <cstdlib>
@@ -15,6 +18,7 @@ namespace
 using fdml_localization::core::Engine;
 using fdml_localization::core::Localizer;
 using fdml_localization::core::LocalizerOptions;
+using fdml_localization::core::MapRayCaster;
 namespace verification = fdml_localization::core::verification;
 
 struct Args
@@ -23,12 +27,18 @@ struct Args
   double minutes = 15.0;
   unsigned long seed = 16;
   int resolution = 64;
+  std::vector<std::string> maps;  ///< empty: verification::smallMaps()
 };
 
 bool parse(int argc, char** argv, Args& args)
 {
   for (int i = 1; i + 1 < argc; i += 2)
   {
+    if (std::strcmp(argv[i], "--map") == 0)
+    {
+      args.maps.emplace_back(argv[i + 1]);
+      continue;
+    }
     char* end = nullptr;
     const double value = std::strtod(argv[i + 1], &end);
     if (end == argv[i + 1] || *end != '\0' || !(value > 0.0) || value > 1e9)
@@ -91,6 +101,46 @@ void add(const verification::Figures& one, verification::Figures& f)
   f.top1 += one.top1;
   f.seconds += one.seconds;
 }
+/// The maps of --map, or without one the small built-in maps; false (and a message) on a bad file.
+bool loadMaps(const Args& args, std::vector<std::shared_ptr<const MapRayCaster>>& maps)
+{
+  try
+  {
+    for (const std::string& path : args.maps)
+    {
+      maps.push_back(std::make_shared<const MapRayCaster>(fdml_localization::core::loadPolyFile(path)));
+    }
+  }
+  catch (const std::exception& e)
+  {
+    std::cerr << "verify_localization: " << e.what() << "\n";
+    return false;
+  }
+  if (maps.empty())
+  {
+    maps = verification::smallMaps();
+  }
+  return true;
+}
+/// Prints the figures per engine and per geometry.
+void report(const Args& args, long trial_count, double seconds, const verification::Figures (&total)[2],
+            const verification::Figures (&by_geometry)[2][verification::kGeometries])
+{
+  std::printf("\n%ld trials per engine in %.0f s (seed %lu, resolution %d, maps %s)\n", trial_count, seconds, args.seed,
+              args.resolution, args.maps.empty() ? "l_room.poly, L-room 8 x 6 m, square_room.poly" : "given");
+  for (std::size_t m = 0; m < args.maps.size(); ++m)
+  {
+    std::printf("map %zu: %s\n", m, args.maps[m].c_str());
+  }
+  for (int e = 0; e < 2; ++e)
+  {
+    print(e == 0 ? "voxel" : "adaptive", total[e]);
+    for (int g = 0; g < verification::kGeometries; ++g)
+    {
+      print(verification::geometryName(g), by_geometry[e][g]);
+    }
+  }
+}
 }  // namespace
 
 int main(int argc, char** argv)
@@ -98,10 +148,15 @@ int main(int argc, char** argv)
   Args args;
   if (!parse(argc, argv, args))
   {
-    std::cerr << "usage: verify_localization [--trials N] [--minutes M] [--seed S] [--resolution N]\n";
+    std::cerr << "usage: verify_localization [--trials N] [--minutes M] [--seed S] [--resolution N] "
+                 "[--map FILE.poly ...]\n";
     return 2;
   }
-  const auto maps = verification::smallMaps();
+  std::vector<std::shared_ptr<const MapRayCaster>> maps;
+  if (!loadMaps(args, maps))
+  {
+    return 2;
+  }
   std::vector<std::unique_ptr<Localizer>> localizers[2];
   for (int e = 0; e < 2; ++e)
   {
@@ -135,18 +190,8 @@ int main(int argc, char** argv)
       }
     }
   }
-  std::printf("\n%ld trials per engine in %.0f s (seed %lu, resolution %d, maps l_room.poly, L-room 8 x 6 m, "
-              "square_room.poly)\n",
-              trial_count, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), args.seed,
-              args.resolution);
-  for (int e = 0; e < 2; ++e)
-  {
-    print(e == 0 ? "voxel" : "adaptive", total[e]);
-    for (int g = 0; g < verification::kGeometries; ++g)
-    {
-      print(verification::geometryName(g), by_geometry[e][g]);
-    }
-  }
+  report(args, trial_count, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), total,
+         by_geometry);
   const bool ok = total[0].missed + total[1].missed + total[0].contradicted + total[1].contradicted == 0;
   return ok ? 0 : 1;
 }

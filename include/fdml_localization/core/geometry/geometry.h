@@ -140,6 +140,26 @@ double pointSegmentDistanceSquared(const Vec2& p, const Segment& seg);
 /// so a vertex on the line is counted once). Symmetric in a and b.
 bool crossesRightOf(const Vec2& p, const Vec2& a, const Vec2& b);
 
+/// Where the horizontal line at height @p y [m] crosses the edge a-b under crossesRightOf's
+/// half-open rule: its x [m], or NaN when it does not cross (crossesRightOf(p, a, b) is
+/// p.x() < horizontalCrossingX(p.y(), a, b)).
+double horizontalCrossingX(double y, const Vec2& a, const Vec2& b);
+
+/// How two closed segments meet, for a parity walk along the first one.
+enum class Crossing
+{
+  None,       ///< disjoint, clearly
+  Proper,     ///< they cross at one point interior to both, clearly
+  Degenerate  ///< an end lies on (or within @p tolerance of) the other's line
+};
+
+/**
+ * @brief Whether segment p-q crosses edge a-b, with a margin: Degenerate when an end of either
+ *        lies within @p tolerance [m] of the other's line (touching, collinear, or too near to
+ *        tell in floating point), so that a caller may fall back to a rule that settles those.
+ */
+Crossing segmentCrossing(const Vec2& p, const Vec2& q, const Vec2& a, const Vec2& b, double tolerance);
+
 /// Crossing-number point-in-ring test (points exactly on the boundary may go either way).
 bool pointInRing(const Vec2& p, const Ring& ring);
 

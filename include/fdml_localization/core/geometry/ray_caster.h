@@ -85,6 +85,14 @@ public:
   /// Number of segments crossed by the horizontal half-line from p towards +x.
   int crossingsToRight(const Vec2& p) const;
 
+  /**
+   * @brief True when crossingsToRight(p) is odd, in time proportional to the segments of p's
+   *        cell instead of its row: the parity stored for the cell's centre, flipped by every
+   *        segment crossing the line from p to that centre (crossingsToRight where p lies on a
+   *        segment's line or that line passes through a vertex, within 1e-9 of the cell size).
+   */
+  bool oddCrossingsToRight(const Vec2& p) const;
+
   const std::vector<Segment>& segments() const
   {
     return segments_;
@@ -101,6 +109,9 @@ public:
 private:
   /// Fills the cells' compressed rows of segment indices.
   void buildCells();
+  /// Fills centre_odd_: per cell, whether crossingsToRight of its centre is odd.
+  void buildCentreParity();
+  Vec2 cellCentre(int cx, int cy) const;
   /// Calls fn(cell index) for every cell the segment touches (cells inflated by a margin).
   template <typename Fn>
   void forEachCellTouching(const Segment& s, Fn&& fn) const;
@@ -121,6 +132,7 @@ private:
   int ny_ = 0;
   std::vector<std::uint32_t> cell_start_;  ///< CSR offsets, size nx*ny+1
   std::vector<int> cell_items_;            ///< segment indices per cell
+  std::vector<std::uint8_t> centre_odd_;   ///< per cell: crossingsToRight(cell centre) is odd
 };
 
 /**

@@ -45,6 +45,14 @@ constexpr double kOffWall = 1e-3;
 Pose2 freeStart(const MapRayCaster& map, const Pose2& start, double reach);
 
 /**
+ * @brief How badly @p pose agrees with @p readings: the sum over readings of r^2 where the
+ *        reading agrees within @p gate [m] (|r| < gate; 0 for a no-return reading nothing in
+ *        range contradicts) and gate^2 where it does not or the sensor is not in free space
+ *        [m^2]; the verdicts and residuals of evaluatePose(), with casts cut at d + gate.
+ */
+double agreementScore(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings, double gate);
+
+/**
  * @brief Of @p poses (of at most @p sampled of them spread over the list), those agreeing best
  *        with @p readings (fewest readings off by more than @p gate [m], then the smallest sum of
  *        squared residuals), each moved off a wall first (freeStart(), within half

@@ -110,17 +110,21 @@ public:
     {
       const LeafCluster& cluster = plateaus[c];
       const std::size_t n = cluster.members.size();
-      for (const Pose2& start : starts[c])
+      for (std::size_t i = 0; i < starts[c].size(); ++i)
       {
         SearchSeed seed;
-        seed.start = start;
+        seed.start = starts[c][i];
         seed.hypothesis = hypothesisOf(found.leaves[cluster.representative], readings_.size());
         seed.promised = level;
         seed.region = c;
         seed.support = static_cast<double>(cluster.size);
         const auto leafStart = [&](std::size_t m) { return freeStart(map_, found.leaves[m].box.centre(), cell_xy_); };
-        seed.retry_starts = { leafStart(cluster.representative), leafStart(cluster.members[n / 3]),
-                              leafStart(cluster.members[(2 * n) / 3]) };
+        if (i == 0)
+        {
+          // The plateau's retry starts go with its first seed: tried once, not once per seed.
+          seed.retry_starts = { leafStart(cluster.representative), leafStart(cluster.members[n / 3]),
+                                leafStart(cluster.members[(2 * n) / 3]) };
+        }
         const std::size_t spread = std::min(n, kRegionStarts);
         for (std::size_t j = 0; j < spread; ++j)
         {
@@ -227,18 +231,10 @@ void AdaptiveEngine::localizeRobust(AdaptiveSearch& search, const std::vector<Re
   result.candidates = std::move(found.candidates);
   searchNoReturnRegion(search, readings, result);
   const auto stage = std::chrono::steady_clock::now();
-  fillUncoveredRegions(*map_, search.result().leaves, readings, options_, latticeRefinement(), result);
+  const std::int64_t theta_cells = std::max<std::int64_t>(1, std::llround(kTwoPi / cell_theta_));
+  fillUncoveredRegions(*map_, search.result().leaves, theta_cells, readings, options_,
+                       latticeRefinement(options_, cell_xy_, cell_theta_), result);
   result.times.polish += secondsSince(stage);
-}
-
-RefinementSettings AdaptiveEngine::latticeRefinement() const
-{
-  RefinementSettings settings;
-  settings.agreement_tolerance = options_.agreement_tolerance;
-  settings.robust_scale = std::max(options_.agreement_tolerance, cell_xy_);
-  settings.seed_position_error = cell_xy_;
-  settings.seed_angle_error = cell_theta_;
-  return settings;
 }
 
 void AdaptiveEngine::searchNoReturnRegion(const AdaptiveSearch& search, const std::vector<Reading>& readings,
@@ -269,7 +265,7 @@ void AdaptiveEngine::searchNoReturnRegion(const AdaptiveSearch& search, const st
   const std::size_t refined = std::min(kNoReturnRefined, lattice_best.size());
   std::partial_sort(lattice_best.begin(), lattice_best.begin() + static_cast<std::ptrdiff_t>(refined),
                     lattice_best.end(), betterCandidate);
-  const RefinementSettings settings = latticeRefinement();
+  const RefinementSettings settings = latticeRefinement(options_, cell_xy_, cell_theta_);
   Candidate found = best;
   for (std::size_t i = 0; i < refined; ++i)
   {

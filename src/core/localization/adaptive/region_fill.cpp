@@ -1,6 +1,7 @@
 // The adaptive engine's last look at the places its seeds missed (region_fill.h).
 #include "fdml_localization/core/localization/adaptive/region_fill.h"
 
+#include "fdml_localization/core/localization/adaptive/leaf_clustering.h"
 #include "fdml_localization/core/localization/ranking.h"
 
 #include <Eigen/Cholesky>
@@ -18,11 +19,12 @@ namespace
 /// Leaves at the best consensus (spread over them) checked; those no candidate accounts for
 /// get their centre pose verified ...
 constexpr std::size_t kFillLeaves = 20000;
-/// ... whose lattice is searched, the best centres first, when the centre explains at most this
-/// many readings fewer than the best candidate ...
+/// ... whose lattice is searched, region by region (round robin, the best centres first) while
+/// no place was found in the region, or when the centre explains at most this many readings
+/// fewer than the best candidate ...
 constexpr int kCentreSlack = 2;
 /// ... at most this many leaves.
-constexpr int kFillTries = 16;
+constexpr int kFillTries = 64;
 /// A leaf's centre within this squared Mahalanobis distance of a candidate is its (chi-square,
 /// 3 degrees of freedom, 99 %).
 constexpr double kChiSquare3Dof = 11.34;
@@ -80,49 +82,58 @@ private:
   std::vector<Entry> entries_;
 };
 
-/// A leaf no candidate accounts for, with its centre pose's net consensus.
+/// A leaf no candidate accounts for, with its centre pose's net consensus and its region.
 struct OpenLeaf
 {
   const LeafBox* leaf;
   Candidate centre;
+  int region;  ///< label of its connected region of leaves reaching the target
+  int rank;    ///< 0 for its region's best centre, 1 for the next, ...
 };
 
 /// The leaves reaching @p target that no candidate accounts for (at most kFillLeaves, spread
-/// over them), each with its centre verified, best centre first.
+/// over them), each with its centre verified, in the order they are searched: round robin over
+/// their connected regions (the best leaf of every region, then the second best, ...; the best
+/// centres first within a rank): a region's place may lie far from its leaves' centres, and on a
+/// large map many separate regions reach the consensus (alike rooms, alcoves).
 std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<LeafBox>& leaves, int target,
-                                 const std::vector<Reading>& readings, const std::vector<Candidate>& candidates,
-                                 const LocalizerOptions& options)
+                                 std::int64_t theta_cells, const std::vector<Reading>& readings,
+                                 const std::vector<Candidate>& candidates, const LocalizerOptions& options)
 {
   Accounting accounting(options);
   for (const Candidate& c : candidates)
   {
     accounting.add(c);
   }
-  std::vector<const LeafBox*> reaching;
-  for (const LeafBox& leaf : leaves)
+  int regions = 0;
+  const std::vector<int> labels = leafComponents(leaves, target, theta_cells, regions);
+  std::vector<std::size_t> reaching;
+  for (std::size_t l = 0; l < leaves.size(); ++l)
   {
-    if (leaf.count >= target)
+    if (labels[l] >= 0)
     {
-      reaching.push_back(&leaf);
+      reaching.push_back(l);
     }
   }
   const std::size_t step = std::max<std::size_t>(1, reaching.size() / kFillLeaves);
   std::vector<OpenLeaf> open;
-  for (std::size_t l = 0; l < reaching.size(); l += step)
+  for (std::size_t j = 0; j < reaching.size(); j += step)
   {
-    const PoseBox& b = reaching[l]->box;
-    if (accounting.accountsFor(b))
+    const LeafBox& leaf = leaves[reaching[j]];
+    if (!accounting.accountsFor(leaf.box))
     {
-      continue;
-    }
-    Candidate c = verifiedCandidate(map, b.centre(), readings, options.agreement_tolerance);
-    if (netConsensus(c) >= target - kCentreSlack)
-    {
-      open.push_back(OpenLeaf{ reaching[l], std::move(c) });
+      open.push_back(OpenLeaf{ &leaf, verifiedCandidate(map, leaf.box.centre(), readings, options.agreement_tolerance),
+                               labels[reaching[j]], 0 });
     }
   }
   std::stable_sort(open.begin(), open.end(),
                    [](const OpenLeaf& a, const OpenLeaf& b) { return betterCandidate(a.centre, b.centre); });
+  std::vector<int> ranked(static_cast<std::size_t>(regions), 0);
+  for (OpenLeaf& o : open)
+  {
+    o.rank = ranked[static_cast<std::size_t>(o.region)]++;
+  }
+  std::stable_sort(open.begin(), open.end(), [](const OpenLeaf& a, const OpenLeaf& b) { return a.rank < b.rank; });
   return open;
 }
 
@@ -167,7 +178,17 @@ std::vector<Candidate> leafLatticeBests(const MapRayCaster& map, const std::vect
   return lattice_best;
 }
 
-int fillUncoveredRegions(const MapRayCaster& map, const std::vector<LeafBox>& leaves,
+RefinementSettings latticeRefinement(const LocalizerOptions& options, double cell_xy, double cell_theta)
+{
+  RefinementSettings settings;
+  settings.agreement_tolerance = options.agreement_tolerance;
+  settings.robust_scale = std::max(options.agreement_tolerance, cell_xy);
+  settings.seed_position_error = cell_xy;
+  settings.seed_angle_error = cell_theta;
+  return settings;
+}
+
+int fillUncoveredRegions(const MapRayCaster& map, const std::vector<LeafBox>& leaves, std::int64_t theta_cells,
                          const std::vector<Reading>& readings, const LocalizerOptions& options,
                          const RefinementSettings& settings, Result& result)
 {
@@ -176,20 +197,29 @@ int fillUncoveredRegions(const MapRayCaster& map, const std::vector<LeafBox>& le
     return 0;
   }
   const int target = netConsensus(result.candidates.front());
-  const std::vector<OpenLeaf> open = openLeaves(map, leaves, target, readings, result.candidates, options);
+  const std::vector<OpenLeaf> open = openLeaves(map, leaves, target, theta_cells, readings, result.candidates, options);
   std::vector<Candidate> added;
   Accounting found(options);  // the open leaves' places found so far
+  int regions = 0;
+  for (const OpenLeaf& o : open)
+  {
+    regions = std::max(regions, o.region + 1);
+  }
+  std::vector<char> placed(static_cast<std::size_t>(regions), 0);  // per region: a place was found in it
   int tried = 0;
   for (std::size_t i = 0; i < open.size() && tried < kFillTries; ++i)
   {
-    if (found.accountsFor(open[i].leaf->box))
+    const OpenLeaf& o = open[i];
+    const bool promising = netConsensus(o.centre) >= target - kCentreSlack;
+    if (found.accountsFor(o.leaf->box) || (placed[static_cast<std::size_t>(o.region)] && !promising))
     {
       continue;
     }
     ++tried;
-    Candidate place = placeInLeaf(map, *open[i].leaf, readings, options, settings);
+    Candidate place = placeInLeaf(map, *o.leaf, readings, options, settings);
     if (netConsensus(place) >= target)
     {
+      placed[static_cast<std::size_t>(o.region)] = 1;
       place.support = 1.0;
       widenAlongContinua(map, readings, settings.noise_sigma, place);
       found.add(place);

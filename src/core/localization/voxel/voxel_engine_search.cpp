@@ -73,8 +73,13 @@ private:
   void addConservativeSeeds(int level, std::vector<SearchSeed>& seeds) const
   {
     const GridSpec& spec = engine_.grid();
-    for (VoxelCluster& c : regionalMaxima(spec, engine_.lastCount(), level, conservative_buckets_[level]))
+    const std::vector<VoxelCluster> maxima =
+        regionalMaxima(spec, engine_.lastCount(), level, conservative_buckets_[level]);
+    std::vector<std::vector<Pose2>> starts(maxima.size());
+#pragma omp parallel for schedule(dynamic, 4) num_threads(engine_.threads()) if (maxima.size() >= 8)
+    for (long m = 0; m < static_cast<long>(maxima.size()); ++m)
     {
+      const VoxelCluster& c = maxima[m];
       const std::size_t n = c.voxels.size();
       const std::size_t samples = std::min(n, kSampledVoxels);
       std::vector<Pose2> poses;
@@ -83,12 +88,21 @@ private:
         poses.push_back(spec.centre(c.voxels[s * n / samples]));
       }
       poses.push_back(c.centroid);
-      const std::vector<bool> hypothesis = engine_.membership(c.representative, engine_.lastPreimages());
-      for (const Pose2& start : bestAgreeingPoses(map_, poses, readings_, gate_, 2.0 * spec.cell,
-                                                  2.0 * spec.thetaStep(), n >= kLargePlateau ? 3 : 1, poses.size()))
+      starts[m] = bestAgreeingPoses(map_, poses, readings_, gate_, 2.0 * spec.cell, 2.0 * spec.thetaStep(),
+                                    n >= kLargePlateau ? 3 : 1, poses.size());
+    }
+    for (std::size_t m = 0; m < maxima.size(); ++m)
+    {
+      const std::vector<bool> hypothesis = engine_.membership(maxima[m].representative, engine_.lastPreimages());
+      for (std::size_t j = 0; j < starts[m].size(); ++j)
       {
-        seeds.push_back(seedOf(c, hypothesis));
-        seeds.back().start = start;
+        seeds.push_back(seedOf(maxima[m], hypothesis));
+        seeds.back().start = starts[m][j];
+        if (j > 0)
+        {
+          // The region's retry starts are its first seed's: tried once, not once per seed.
+          seeds.back().retry_starts.clear();
+        }
       }
     }
   }

@@ -46,9 +46,6 @@ private:
   /// added when it beats the best candidate. The polish moves poses by finite ranges only, so a
   /// region that no-return readings shape is searched rather than polished.
   void searchNoReturnRegion(const AdaptiveSearch& search, const std::vector<Reading>& readings, Result& result) const;
-  /// The refinement of a lattice pose (searchNoReturnRegion(), fillUncoveredRegions()): seeds one
-  /// leaf from the optimum.
-  RefinementSettings latticeRefinement() const;
 
   std::shared_ptr<const MapRayCaster> map_;
   LocalizerOptions options_;

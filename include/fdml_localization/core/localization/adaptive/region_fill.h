@@ -14,6 +14,7 @@
 #include "fdml_localization/core/localization/robust_search.h"
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace fdml_localization
@@ -31,15 +32,25 @@ std::vector<Candidate> leafLatticeBests(const MapRayCaster& map, const std::vect
                                         std::size_t max_leaves, const std::vector<Reading>& readings, double eps);
 
 /**
+ * @brief The refinement of a lattice pose in a leaf (or voxel) of @p cell_xy [m] by
+ *        @p cell_theta [rad]: seeded one leaf from the optimum, at least eps wide.
+ */
+RefinementSettings latticeRefinement(const LocalizerOptions& options, double cell_xy, double cell_theta);
+
+/**
  * @brief Adds to @p result (ranked, de-duplicated, at most max_candidates) the places its
  *        candidates miss: among @p leaves reaching the best candidate's net consensus, those no
  *        candidate accounts for (its pose within the uniqueness margins of the leaf, or the leaf's
- *        centre within 3 sigma of its covariance), the best centre poses first, get a lattice
- *        search refined with @p settings; a pose reaching that consensus joins and accounts for
- *        the leaves around it. At most kFillTries leaves are searched.
+ *        centre within 3 sigma of its covariance) get a lattice search refined with @p settings;
+ *        a pose reaching that consensus joins and accounts for the leaves around it. The leaves
+ *        go round robin over their connected regions (26 neighbours, @p theta_cells heading cells
+ *        around the circle): every region's best leaf (by its centre pose), then its second, ...,
+ *        a region's further leaves only while no place was found in it or when their centre
+ *        explains within two readings of the consensus; at most 64 leaves. On a large map many
+ *        regions can reach the consensus (alike rooms, alcoves) and each may hold the truth.
  * @return the leaves searched
  */
-int fillUncoveredRegions(const MapRayCaster& map, const std::vector<LeafBox>& leaves,
+int fillUncoveredRegions(const MapRayCaster& map, const std::vector<LeafBox>& leaves, std::int64_t theta_cells,
                          const std::vector<Reading>& readings, const LocalizerOptions& options,
                          const RefinementSettings& settings, Result& result);
 

@@ -21,8 +21,6 @@ namespace
 constexpr std::size_t kRetriedSeeds = 32;
 /// ... of which this many first get a local lattice search around their start.
 constexpr std::size_t kLocallySearchedSeeds = 8;
-/// Optima of one multi-start closer than this [m] and [rad] are one optimum.
-constexpr double kSameOptimum = 1e-3;
 
 /// What refining a seed needs.
 struct SearchContext
@@ -237,17 +235,19 @@ private:
         kept[j] = std::move(polished);
       }
       widenAlongContinua(ctx_.map, ctx_.readings, ctx_.settings.noise_sigma, kept[j]);
-      // Distinct optima: a tie within the uniqueness margins of kept[j] is dropped as its
-      // duplicate only after it widened kept[j]'s covariance (absorbTiedDuplicates()).
-      ties[j] = rankAndDeduplicate(std::move(ties[j]), kSameOptimum, kSameOptimum, options.max_candidates);
+      // A tie within the uniqueness margins of kept[j] is its duplicate, but first widens its
+      // covariance to cover it (absorbTiedDuplicates()): de-duplicated among themselves first,
+      // the ties could lose the one that is the truth.
+      std::vector<Candidate> own{ kept[j] };
+      absorbTiedDuplicates(ties[j], options.uniqueness_distance, options.uniqueness_angle, ctx_.settings.noise_sigma,
+                           own);
+      kept[j].covariance = own.front().covariance;
+      ties[j] = rankAndDeduplicate(std::move(ties[j]), options.uniqueness_distance, options.uniqueness_angle,
+                                   options.max_candidates);
       for (Candidate& tie : ties[j])
       {
         tie.support = kept[j].support;
-        const Eigen::Vector3d d = poseDifference(tie.pose, kept[j].pose);
-        if (d.head<2>().norm() >= options.uniqueness_distance || std::abs(d.z()) >= options.uniqueness_angle)
-        {
-          widenAlongContinua(ctx_.map, ctx_.readings, ctx_.settings.noise_sigma, tie);
-        }
+        widenAlongContinua(ctx_.map, ctx_.readings, ctx_.settings.noise_sigma, tie);
       }
     }
     for (std::vector<Candidate>& found : ties)

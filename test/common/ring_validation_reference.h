@@ -8,9 +8,18 @@
 
 #include "fdml_localization/core/map/polygon_map.h"
 
+// Boost 1.74's rescale policy trips GCC 12's -Wmaybe-uninitialized (a false positive inside
+// Boost, get_rescale_policy.hpp): silenced for these headers only.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #include <boost/geometry.hpp>
 #include <boost/geometry/geometries/point_xy.hpp>
 #include <boost/geometry/geometries/polygon.hpp>
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
 
 #include <algorithm>
 #include <vector>

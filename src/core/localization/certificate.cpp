@@ -20,25 +20,6 @@ constexpr int kExclusionDepth = 3;
 /// Box tests the exclusion of all regions may spend.
 constexpr long kExclusionBudget = 20000;
 
-/// The readings @p box may explain (box test of adaptive_search.h), counted until it is clear
-/// whether @p needed is reached.
-int boxCount(const MapRayCaster& map, const std::vector<Reading>& readings, double tolerance, const PoseBox& box,
-             int needed)
-{
-  const Box2 positions{ Vec2(box.x0, box.y0), Vec2(box.x1, box.y1) };
-  if (!map.grid().anySegmentInBox(positions) && !map.isFree(0.5 * (positions.min + positions.max)))
-  {
-    return 0;  // the robot's base is outside free space everywhere in the box
-  }
-  int count = 0;
-  const int k = static_cast<int>(readings.size());
-  for (int i = 0; i < k && count + (k - i) >= needed; ++i)
-  {
-    count += readingMayExplain(map, readings[static_cast<std::size_t>(i)], box, tolerance) ? 1 : 0;
-  }
-  return count;
-}
-
 /// True when some sub-box of @p box, halved @p depth times along every axis, may still explain
 /// @p needed readings (or the budget ran out).
 bool mayReach(const MapRayCaster& map, const std::vector<Reading>& readings, double tolerance, const PoseBox& box,
@@ -48,7 +29,7 @@ bool mayReach(const MapRayCaster& map, const std::vector<Reading>& readings, dou
   {
     return true;
   }
-  if (boxCount(map, readings, tolerance, box, needed) < needed)
+  if (boxConsensusBound(map, readings, tolerance, box, needed) < needed)
   {
     return false;
   }
@@ -56,14 +37,9 @@ bool mayReach(const MapRayCaster& map, const std::vector<Reading>& readings, dou
   {
     return true;
   }
-  const double xm = 0.5 * (box.x0 + box.x1), ym = 0.5 * (box.y0 + box.y1), tm = 0.5 * (box.t0 + box.t1);
   for (int c = 0; c < 8; ++c)
   {
-    PoseBox child = box;
-    ((c & 1) ? child.x0 : child.x1) = xm;
-    ((c & 2) ? child.y0 : child.y1) = ym;
-    ((c & 4) ? child.t0 : child.t1) = tm;
-    if (mayReach(map, readings, tolerance, child, needed, depth - 1, budget))
+    if (mayReach(map, readings, tolerance, box.half(c), needed, depth - 1, budget))
     {
       return true;
     }

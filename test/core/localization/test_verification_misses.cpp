@@ -131,6 +131,26 @@ const std::pair<const char*, int> kBundledMapMisses[] = {
   { "driving map 4 k 19 exact truth (7.7301696225905774, 2.2502353844054599, -0.87505177060145778)", 64 },
   // Its first leaf's lattice refined to 18 of 19 readings 20 cm off: the region's next leaves.
   { "driving map 4 k 19 exact truth (7.7301696225905774, 2.2502353844054599, -0.87505177060145778)", 100 },
+  // Places a few centimetres wide (rays grazing corners, short no-return ranges): a lattice of
+  // the whole leaf missed them, its sub-boxes find them (placeInLeaf()).
+  { "no-return map 3 k 6 exact truth (28.815830908199356, 1.4852962530705711, -0.17167784249120377) max range "
+    "1.6688911968678346",
+    64 },
+  { "grazing map 2 k 4 exact truth (46.562916255942653, 16.175495375141647, -3.076620637229539)", 64 },
+  { "no-return map 3 k 13 exact truth (26.381324822881957, 3.2407633198925927, 2.7078959297860861) max range "
+    "2.3637228013511424",
+    64 },
+  { "no-return map 3 k 8 exact truth (35.555483879919223, 1.7816582839538329, -3.087170903859112) max range "
+    "1.4254066600452902",
+    64 },
+  // 377 regions at the consensus in the warehouse: the truth's beyond the first 64 leaves.
+  { "driving map 2 k 14 exact truth (17.908513613491316, 2.8717682647806093, -2.4908945036314423)", 64 },
+  // The best candidate (23 of 30) lay on a corridor continuum holding the truth (30 of 30): a
+  // leaf that may beat the best candidate is searched even where a candidate accounts for it.
+  { "driving map 3 k 30 exact truth (11.905795181301755, 2.2109756034548846, -0.78963964898705941)", 64 },
+  // An approximate candidate's continuum (sd 40 m along the corridor) reached the exact truth's
+  // leaf: such leaves are searched after the others, and a place there joins when it is better.
+  { "driving map 3 k 5 exact truth (6.8620198920421416, 2.6024230434802158, -0.10970389281797122)", 64 },
 };
 
 TEST(PastMissesOnBundledMaps, TheAdaptiveEngineSearchesEveryRegionReachingTheConsensus)

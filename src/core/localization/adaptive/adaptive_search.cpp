@@ -142,6 +142,23 @@ bool readingMayExplain(const MapRayCaster& map, const Reading& reading, const Po
   return map.grid().anySegmentInBox(sweep(positions, hitArcBounds(reading, box.t0, box.t1), range_tolerance));
 }
 
+int boxConsensusBound(const MapRayCaster& map, const std::vector<Reading>& readings, double range_tolerance,
+                      const PoseBox& box, int needed)
+{
+  const Box2 positions{ Vec2(box.x0, box.y0), Vec2(box.x1, box.y1) };
+  if (!map.grid().anySegmentInBox(positions) && !map.isFree(0.5 * (positions.min + positions.max)))
+  {
+    return 0;
+  }
+  int count = 0;
+  const int k = static_cast<int>(readings.size());
+  for (int i = 0; i < k && count + (k - i) >= needed; ++i)
+  {
+    count += readingMayExplain(map, readings[static_cast<std::size_t>(i)], box, range_tolerance) ? 1 : 0;
+  }
+  return count;
+}
+
 AdaptiveSearchResult adaptiveSearch(const MapRayCaster& map, const std::vector<Reading>& readings,
                                     const AdaptiveSearchOptions& options)
 {

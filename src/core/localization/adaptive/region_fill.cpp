@@ -2,6 +2,7 @@
 #include "fdml_localization/core/localization/adaptive/region_fill.h"
 
 #include "fdml_localization/core/localization/adaptive/leaf_clustering.h"
+#include "fdml_localization/core/localization/adaptive/leaf_search.h"
 #include "fdml_localization/core/localization/ranking.h"
 
 #include <Eigen/Cholesky>
@@ -16,22 +17,22 @@ namespace core
 {
 namespace
 {
-/// Leaves at the best consensus (spread over them) checked; those no candidate accounts for
-/// get their centre pose verified ...
+/// Leaves at the best consensus (spread over them) checked; those holding no candidate get
+/// their centre pose verified and are searched (searchLeafForPlace(); the order is
+/// fillUncoveredRegions()'s) ...
 constexpr std::size_t kFillLeaves = 20000;
-/// ... whose lattice is searched, region by region (round robin, the best centres first) while
-/// no place was found in the region, or when the centre explains at most this many readings
-/// fewer than the best candidate ...
-constexpr int kCentreSlack = 2;
-/// ... at most this many leaves.
+/// ... at least this many of them (where as many are open) ...
 constexpr int kFillTries = 64;
+/// ... or, beyond those, while the leaves' box tests (searchLeafForPlace()) stay within this many.
+constexpr long kFillBoxTests = 20000;
 /// A leaf's centre within this squared Mahalanobis distance of a candidate is its (chi-square,
 /// 3 degrees of freedom, 99 %).
 constexpr double kChiSquare3Dof = 11.34;
 
 /// What candidates account for: a leaf box holding a candidate's pose within the uniqueness
-/// margins, or whose centre lies within 3 sigma of the candidate's covariance grown by the leaf's
-/// size (a continuum). The grown covariance is factorised once per candidate and leaf size.
+/// margins (the candidate's own place), or whose centre lies within 3 sigma of the candidate's
+/// covariance grown by the leaf's size (its continuum: a corridor, parallel walls). The grown
+/// covariance is factorised once per candidate and leaf size.
 class Accounting
 {
 public:
@@ -41,41 +42,50 @@ public:
   void add(const Candidate& candidate)
   {
     // Factorised here too so that it is never read uninitialised; a leaf size replaces it.
-    entries_.push_back(
-        Entry{ candidate.pose, candidate.covariance, Eigen::LDLT<Eigen::Matrix3d>(candidate.covariance), -1.0, -1.0 });
+    entries_.push_back(Entry{ candidate, Eigen::LDLT<Eigen::Matrix3d>(candidate.covariance), -1.0, -1.0 });
   }
 
-  bool accountsFor(const PoseBox& box)
+  /// True when a candidate's pose lies in @p box (within the uniqueness margins).
+  bool holds(const PoseBox& box) const
+  {
+    return std::any_of(entries_.begin(), entries_.end(), [&](const Entry& e) {
+      return box.contains(e.candidate.pose, options_.uniqueness_distance, options_.uniqueness_angle);
+    });
+  }
+
+  /// The candidate whose continuum reaches @p box's centre, or null.
+  const Candidate* continuumAt(const PoseBox& box)
   {
     const double cx = box.x1 - box.x0, ct = box.t1 - box.t0;
     const Pose2 centre = box.centre();
     for (Entry& e : entries_)
     {
-      if (box.contains(e.pose, options_.uniqueness_distance, options_.uniqueness_angle))
-      {
-        return true;
-      }
       if (cx != e.cell_xy || ct != e.cell_theta)
       {
         e.cell_xy = cx;
         e.cell_theta = ct;
-        e.spread.compute(e.covariance + Eigen::Vector3d(cx * cx, cx * cx, ct * ct).asDiagonal().toDenseMatrix());
+        e.spread.compute(e.candidate.covariance +
+                         Eigen::Vector3d(cx * cx, cx * cx, ct * ct).asDiagonal().toDenseMatrix());
       }
-      const Eigen::Vector3d d = poseDifference(centre, e.pose);
+      const Eigen::Vector3d d = poseDifference(centre, e.candidate.pose);
       if (d.dot(e.spread.solve(d)) <= kChiSquare3Dof)
       {
-        return true;
+        return &e.candidate;
       }
     }
-    return false;
+    return nullptr;
+  }
+
+  bool accountsFor(const PoseBox& box)
+  {
+    return holds(box) || continuumAt(box) != nullptr;
   }
 
 private:
   struct Entry
   {
-    Pose2 pose;
-    Eigen::Matrix3d covariance;
-    Eigen::LDLT<Eigen::Matrix3d> spread;  ///< of covariance + the leaf size below, squared
+    Candidate candidate;
+    Eigen::LDLT<Eigen::Matrix3d> spread;  ///< of its covariance + the leaf size below, squared
     double cell_xy, cell_theta;           ///< [m], [rad]
   };
   const LocalizerOptions& options_;
@@ -89,13 +99,18 @@ struct OpenLeaf
   Candidate centre;
   int region;  ///< label of its connected region of leaves reaching the target
   int rank;    ///< 0 for its region's best centre, 1 for the next, ...
+  /// The candidate whose continuum reaches the leaf (inliers -1: none): a place found in the
+  /// leaf joins only when better than it.
+  Candidate rival;
 };
 
-/// The leaves reaching @p target that no candidate accounts for (at most kFillLeaves, spread
-/// over them), each with its centre verified, in the order they are searched: round robin over
-/// their connected regions (the best leaf of every region, then the second best, ...; the best
-/// centres first within a rank): a region's place may lie far from its leaves' centres, and on a
-/// large map many separate regions reach the consensus (alike rooms, alcoves).
+/// The leaves reaching @p target that hold no candidate's pose (at most kFillLeaves, spread over
+/// them), each with its centre verified, in the order they are searched: round robin over their
+/// connected regions (the best leaf of every region, then the second best, ...; the best centres
+/// first within a rank). A region's place may
+/// lie far from its leaves' centres, on a large map many separate regions reach the consensus
+/// (alike rooms, alcoves), and a continuum's candidate (sd of metres along a corridor) can be an
+/// approximate place while an exact one lies on it.
 std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<LeafBox>& leaves, int target,
                                  std::int64_t theta_cells, const std::vector<Reading>& readings,
                                  const std::vector<Candidate>& candidates, const LocalizerOptions& options)
@@ -120,14 +135,27 @@ std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<Leaf
   for (std::size_t j = 0; j < reaching.size(); j += step)
   {
     const LeafBox& leaf = leaves[reaching[j]];
-    if (!accounting.accountsFor(leaf.box))
+    // A leaf that may beat the candidates is open even where one's pose lies in it.
+    if (leaf.count <= target && accounting.holds(leaf.box))
     {
-      open.push_back(OpenLeaf{ &leaf, verifiedCandidate(map, leaf.box.centre(), readings, options.agreement_tolerance),
-                               labels[reaching[j]], 0 });
+      continue;
     }
+    OpenLeaf o{ &leaf, Candidate(), labels[reaching[j]], 0, Candidate() };
+    o.rival.inliers = -1;
+    if (const Candidate* rival = accounting.continuumAt(leaf.box))
+    {
+      o.rival = *rival;
+      o.centre.inliers = -1;  // verified when searched: such leaves wait for pass 1
+    }
+    else
+    {
+      o.centre = verifiedCandidate(map, leaf.box.centre(), readings, options.agreement_tolerance);
+    }
+    open.push_back(std::move(o));
   }
-  std::stable_sort(open.begin(), open.end(),
-                   [](const OpenLeaf& a, const OpenLeaf& b) { return betterCandidate(a.centre, b.centre); });
+  std::stable_sort(open.begin(), open.end(), [](const OpenLeaf& a, const OpenLeaf& b) {
+    return a.centre.inliers >= 0 && (b.centre.inliers < 0 || betterCandidate(a.centre, b.centre));
+  });
   std::vector<int> ranked(static_cast<std::size_t>(regions), 0);
   for (OpenLeaf& o : open)
   {
@@ -137,17 +165,83 @@ std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<Leaf
   return open;
 }
 
-/// The best pose of @p leaf's lattice (leafLatticeBests()), refined and kept when the refinement
-/// stays within two leaves of its start (the polish may slide far along a continuum).
-Candidate placeInLeaf(const MapRayCaster& map, const LeafBox& leaf, const std::vector<Reading>& readings,
-                      const LocalizerOptions& options, const RefinementSettings& settings)
+/// The order the open leaves are searched in: first those whose bound exceeds @p target, the
+/// highest bounds first (a place there beats the best candidate and raises the target), then all
+/// of them in openLeaves()' round robin.
+std::vector<std::size_t> searchOrder(const std::vector<OpenLeaf>& open, int target)
 {
-  Candidate best = leafLatticeBests(map, { &leaf }, 1, readings, options.agreement_tolerance).front();
-  Candidate c = refineSeed(map, best.pose, readings, best.inlier_mask, settings);
-  const Eigen::Vector3d moved = poseDifference(c.pose, best.pose);
-  const bool near = moved.head<2>().norm() <= 2.0 * (leaf.box.x1 - leaf.box.x0) &&
-                    std::abs(moved.z()) <= 2.0 * (leaf.box.t1 - leaf.box.t0);
-  return near && betterCandidate(c, best) ? c : best;
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < open.size(); ++i)
+  {
+    if (open[i].leaf->count > target)
+    {
+      order.push_back(i);
+    }
+  }
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return open[a].leaf->count > open[b].leaf->count; });
+  for (std::size_t i = 0; i < open.size(); ++i)
+  {
+    order.push_back(i);
+  }
+  return order;
+}
+
+/// The fill's progress over the open leaves.
+struct FillState
+{
+  int target;                    ///< the net consensus a place must reach
+  Accounting found;              ///< the places found so far
+  std::vector<Candidate> added;  ///< ... and their candidates
+  std::vector<char> placed;      ///< per region: a place was found in it
+  std::vector<char> searched;    ///< per open leaf
+  int tried;                     ///< leaves searched
+  long budget;                   ///< box tests left
+};
+
+/// One pass over the open leaves in @p order. Pass 0 leaves for pass 1 (while the budget lasts)
+/// the leaves of regions holding a place and those on a candidate's continuum: mostly they hold
+/// those places again.
+void fillPass(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
+              const RefinementSettings& settings, std::vector<OpenLeaf>& open, const std::vector<std::size_t>& order,
+              int pass, FillState& state)
+{
+  for (const std::size_t i : order)
+  {
+    OpenLeaf& o = open[i];
+    // A leaf whose bound exceeds the target may hold a better place: it is searched for one.
+    const bool beyond = o.leaf->count > state.target;
+    const bool promising =
+        beyond || (o.centre.inliers >= 0 && netConsensus(o.centre) >= state.target - kPromisingSlack);
+    const bool deferred =
+        !beyond && (o.rival.inliers >= 0 || (state.placed[static_cast<std::size_t>(o.region)] && !promising));
+    if (state.budget <= 0 && (pass == 1 || state.tried >= kFillTries))
+    {
+      return;
+    }
+    if (state.searched[i] || o.leaf->count < state.target || (pass == 0 && deferred) ||
+        (!beyond && state.found.accountsFor(o.leaf->box)))
+    {
+      continue;
+    }
+    state.searched[i] = 1;
+    ++state.tried;
+    if (o.centre.inliers < 0)
+    {
+      o.centre = verifiedCandidate(map, o.leaf->box.centre(), readings, options.agreement_tolerance);
+    }
+    Candidate place = searchLeafForPlace(map, *o.leaf, o.centre, readings, options, settings,
+                                         beyond ? state.target + 1 : state.target, state.budget);
+    if (netConsensus(place) >= state.target && (o.rival.inliers < 0 || betterCandidate(place, o.rival)))
+    {
+      state.target = netConsensus(place);
+      state.placed[static_cast<std::size_t>(o.region)] = 1;
+      place.support = 1.0;
+      widenAlongContinua(map, readings, settings.noise_sigma, place);
+      state.found.add(place);
+      state.added.push_back(std::move(place));
+    }
+  }
 }
 
 }  // namespace
@@ -196,43 +290,28 @@ int fillUncoveredRegions(const MapRayCaster& map, const std::vector<LeafBox>& le
   {
     return 0;
   }
-  const int target = netConsensus(result.candidates.front());
-  const std::vector<OpenLeaf> open = openLeaves(map, leaves, target, theta_cells, readings, result.candidates, options);
-  std::vector<Candidate> added;
-  Accounting found(options);  // the open leaves' places found so far
+  int target = netConsensus(result.candidates.front());
+  std::vector<OpenLeaf> open = openLeaves(map, leaves, target, theta_cells, readings, result.candidates, options);
+  FillState state{ target, Accounting(options), {}, {}, std::vector<char>(open.size(), 0), 0, kFillBoxTests };
   int regions = 0;
   for (const OpenLeaf& o : open)
   {
     regions = std::max(regions, o.region + 1);
   }
-  std::vector<char> placed(static_cast<std::size_t>(regions), 0);  // per region: a place was found in it
-  int tried = 0;
-  for (std::size_t i = 0; i < open.size() && tried < kFillTries; ++i)
+  state.placed.assign(static_cast<std::size_t>(regions), 0);
+  const std::vector<std::size_t> order = searchOrder(open, target);
+  for (int pass = 0; pass < 2; ++pass)
   {
-    const OpenLeaf& o = open[i];
-    const bool promising = netConsensus(o.centre) >= target - kCentreSlack;
-    if (found.accountsFor(o.leaf->box) || (placed[static_cast<std::size_t>(o.region)] && !promising))
-    {
-      continue;
-    }
-    ++tried;
-    Candidate place = placeInLeaf(map, *o.leaf, readings, options, settings);
-    if (netConsensus(place) >= target)
-    {
-      placed[static_cast<std::size_t>(o.region)] = 1;
-      place.support = 1.0;
-      widenAlongContinua(map, readings, settings.noise_sigma, place);
-      found.add(place);
-      added.push_back(std::move(place));
-    }
+    fillPass(map, readings, options, settings, open, order, pass, state);
   }
+  std::vector<Candidate>& added = state.added;
   if (!added.empty())
   {
     std::move(added.begin(), added.end(), std::back_inserter(result.candidates));
     result.candidates = rankAndDeduplicate(std::move(result.candidates), options.uniqueness_distance,
                                            options.uniqueness_angle, options.max_candidates);
   }
-  return tried;
+  return state.tried;
 }
 
 }  // namespace core

@@ -1,7 +1,9 @@
 // The adaptive engine's box search: the arc bounds and the box test are conservative, the
 // occupancy grid never answers "no" wrongly, the search never loses the truth with exact
-// readings, resuming at a lower k' equals a fresh search, and the budgets cut the search.
+// readings, resuming at a lower k' equals a fresh search, the budgets cut the search, and the
+// box consensus bound below a count proves no pose of the box reaches it.
 #include "fdml_localization/core/localization/adaptive/adaptive_search.h"
+#include "fdml_localization/core/localization/certificate.h"
 #include "fdml_localization/simulation/map_generators.h"
 
 #include "localizer_test_utils.h"
@@ -146,6 +148,43 @@ TEST(ReadingMayExplain, NoReturnBoxTestIsConservativeAndPrunes)
   }
   EXPECT_GT(blocked_boxes, 1000);
   EXPECT_GT(rejected, blocked_boxes / 4) << rejected << " of " << blocked_boxes;
+}
+
+TEST(AdaptiveSearch, BoxConsensusBoundBelowNeededProvesNoPoseReachesIt)
+{
+  // Readings from a pose near q: the poses of a box holding q explain some of them. Whenever the
+  // bound says fewer than `needed`, q (inside the box) must explain fewer; and it does prune.
+  const auto map = test::loadMap("maps/apartment.poly");
+  const double tau = 0.03;
+  std::mt19937_64 rng(21);
+  std::uniform_real_distribution<double> size(0.005, 0.4), jitter(-0.15, 0.15), heading(-kPi, kPi);
+  int pruned = 0;
+  for (int trial = 0; trial < 3000; ++trial)
+  {
+    const Pose2 q = anyFreePose(*map, rng);
+    std::vector<Pose2> offsets;
+    for (int i = 0; i < 6; ++i)
+    {
+      offsets.emplace_back(0.0, 0.0, heading(rng));
+    }
+    Pose2 source;
+    do
+    {
+      source = Pose2(q.x + jitter(rng), q.y + jitter(rng), q.theta + 0.5 * jitter(rng));
+    } while (!map->isFree(source.position()));
+    const std::vector<Reading> readings = test::exactReadings(*map, source, offsets);
+    const PoseBox box = boxHolding(q, size(rng), size(rng), 0.5 * size(rng), rng);
+    const int at_q = consensusWithin(*map, q, readings, tau);
+    for (int needed = 1; needed <= 6; ++needed)
+    {
+      if (boxConsensusBound(*map, readings, tau, box, needed) < needed)
+      {
+        ASSERT_LT(at_q, needed) << "trial " << trial << " needed " << needed;
+        ++pruned;
+      }
+    }
+  }
+  EXPECT_GT(pruned, 3000);
 }
 
 TEST(BoxOccupancy, NoIsNeverWrong)

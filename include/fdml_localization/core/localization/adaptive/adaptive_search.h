@@ -48,6 +48,17 @@ struct PoseBox
     return q.x >= x0 - margin && q.x <= x1 + margin && q.y >= y0 - margin && q.y <= y1 + margin &&
            (within(t) || within(t + kTwoPi) || within(t - kTwoPi));
   }
+
+  /// The @p c-th (0 to 7) of the 8 boxes every axis halved gives: bit 0 set for the upper half
+  /// in x, bit 1 in y, bit 2 in theta.
+  PoseBox half(int c) const
+  {
+    PoseBox h = *this;
+    ((c & 1) ? h.x0 : h.x1) = 0.5 * (x0 + x1);
+    ((c & 2) ? h.y0 : h.y1) = 0.5 * (y0 + y1);
+    ((c & 4) ? h.t0 : h.t1) = 0.5 * (t0 + t1);
+    return h;
+  }
 };
 
 /// A surviving leaf box, with the number of readings that may be explained in it.
@@ -94,6 +105,15 @@ struct AdaptiveSearchResult
 /// The conservative per-reading box test (exposed for tests): false only when the reading
 /// provably cannot be explained by any pose in @p box.
 bool readingMayExplain(const MapRayCaster& map, const Reading& reading, const PoseBox& box, double range_tolerance);
+
+/**
+ * @brief How many of @p readings some pose in @p box may explain (readingMayExplain() per
+ *        reading, 0 when the robot's base is outside free space everywhere in the box), counted
+ *        only until it is clear whether @p needed is reached: a result below @p needed proves
+ *        that no pose in the box explains @p needed readings.
+ */
+int boxConsensusBound(const MapRayCaster& map, const std::vector<Reading>& readings, double range_tolerance,
+                      const PoseBox& box, int needed);
 
 /// Exact bounding box of the arc R(theta) v for theta in [t0, t1] (t1 - t0 <= 2 pi).
 Box2 rotatedArcBounds(const Vec2& v, double t0, double t1);

@@ -1,10 +1,10 @@
 /**
  * @file region_fill.h
  * @brief The adaptive engine's last look at the places its seeds missed (issue 16): the leaves
- *        reaching the best candidate's consensus that no candidate accounts for are searched with
- *        a lattice of exactly verified poses, refined; a pose explaining as many readings as the
- *        best candidate joins the candidates. Where the readings leave a continuum (few finite
- *        ranges, alike rooms), one region of leaves can hold several places and the seeds' polish
+ *        reaching the best candidate's consensus that hold no candidate are searched through
+ *        their sub-boxes (pruned by the box bound), the best verified pose refined; a pose
+ *        explaining as many readings as the best candidate (or more) joins the candidates. Where the readings leave a
+ * continuum (few finite ranges, alike rooms), one region of leaves can hold several places and the seeds' polish
  *        reaches some and not others; this finds the rest.
  */
 #pragma once
@@ -39,15 +39,19 @@ RefinementSettings latticeRefinement(const LocalizerOptions& options, double cel
 
 /**
  * @brief Adds to @p result (ranked, de-duplicated, at most max_candidates) the places its
- *        candidates miss: among @p leaves reaching the best candidate's net consensus, those no
- *        candidate accounts for (its pose within the uniqueness margins of the leaf, or the leaf's
- *        centre within 3 sigma of its covariance) get a lattice search refined with @p settings;
- *        a pose reaching that consensus joins and accounts for the leaves around it. The leaves
- *        go round robin over their connected regions (26 neighbours, @p theta_cells heading cells
- *        around the circle): every region's best leaf (by its centre pose), then its second, ...,
- *        a region's further leaves only while no place was found in it or when their centre
- *        explains within two readings of the consensus; at most 64 leaves. On a large map many
- *        regions can reach the consensus (alike rooms, alcoves) and each may hold the truth.
+ *        candidates miss. Open: the @p leaves reaching the best candidate's net consensus whose
+ *        box holds no candidate's pose (within the uniqueness margins); a leaf whose centre lies
+ *        within 3 sigma of a candidate's covariance grown by the leaf's size is on its continuum.
+ *        Searched first the leaves whose bound exceeds the consensus (highest first; a place
+ *        there raises it), then round robin over their connected regions (26 neighbours,
+ *        @p theta_cells heading cells around the circle: every region's best leaf by its centre,
+ *        then its second, ..., further leaves only while no place was found in the region or
+ *        when their centre explains within two readings of the consensus), then, while the
+ *        budget lasts, the leaves left: of regions holding a place, and on a continuum (a place
+ *        there joins only when better than that candidate). At least 64 leaves, more while
+ *        their box tests stay within 20,000. Each leaf is searched through its sub-boxes (every
+ *        axis halved four times, only halves whose boxConsensusBound() reaches the target, the
+ *        best 16 per level), the best centre refined with @p settings scaled to its sub-box.
  * @return the leaves searched
  */
 int fillUncoveredRegions(const MapRayCaster& map, const std::vector<LeafBox>& leaves, std::int64_t theta_cells,

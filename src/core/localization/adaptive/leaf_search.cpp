@@ -1,0 +1,95 @@
+// The search of one leaf for a place reaching a consensus (leaf_search.h).
+#include "fdml_localization/core/localization/adaptive/leaf_search.h"
+
+#include "fdml_localization/core/localization/ranking.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace fdml_localization
+{
+namespace core
+{
+namespace
+{
+/// Halvings of every axis of the leaf ...
+constexpr int kFillDepth = 4;
+/// ... keeping at most this many sub-boxes per level (the best centres).
+constexpr std::size_t kFillBeam = 16;
+
+/// A sub-box of a leaf that may still explain the target, with its centre pose verified.
+struct SubBox
+{
+  PoseBox box;
+  Candidate centre;
+};
+
+/// The 8 halves of @p box (every axis halved) that may still explain @p target readings, each
+/// with its centre verified; @p budget counts the box tests down.
+void keptHalves(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
+                const PoseBox& box, int target, long& budget, std::vector<SubBox>& kept)
+{
+  for (int c = 0; c < 8; ++c)
+  {
+    const PoseBox half = box.half(c);
+    --budget;
+    if (boxConsensusBound(map, readings, options.range_tolerance, half, target) >= target)
+    {
+      kept.push_back(SubBox{ half, verifiedCandidate(map, half.centre(), readings, options.agreement_tolerance) });
+    }
+  }
+}
+
+}  // namespace
+
+Candidate searchLeafForPlace(const MapRayCaster& map, const LeafBox& leaf, const Candidate& centre,
+                             const std::vector<Reading>& readings, const LocalizerOptions& options,
+                             RefinementSettings settings, int target, long& box_tests)
+{
+  Candidate best = centre, refined = centre;
+  PoseBox best_box = leaf.box;
+  bool pending = false;  // best is not refined yet
+  std::vector<SubBox> level{ SubBox{ leaf.box, centre } };
+  for (int depth = 1; depth <= kFillDepth && !level.empty(); ++depth)
+  {
+    std::vector<SubBox> next;
+    for (const SubBox& b : level)
+    {
+      keptHalves(map, readings, options, b.box, target, box_tests, next);
+    }
+    const std::size_t beam = std::min(next.size(), kFillBeam);
+    std::partial_sort(next.begin(), next.begin() + static_cast<std::ptrdiff_t>(beam), next.end(),
+                      [](const SubBox& a, const SubBox& b) { return betterCandidate(a.centre, b.centre); });
+    next.resize(beam);
+    if (!next.empty() && (depth == 1 || betterCandidate(next.front().centre, best)))
+    {
+      best = next.front().centre;
+      best_box = next.front().box;
+      pending = true;
+    }
+    // Refined near the target, or at the last level: most leaves hold no place.
+    if (pending && !next.empty() && (netConsensus(best) >= target - kPromisingSlack || depth == kFillDepth))
+    {
+      pending = false;
+      settings.robust_scale = std::max(options.agreement_tolerance, best_box.x1 - best_box.x0);
+      settings.seed_position_error = best_box.x1 - best_box.x0;
+      settings.seed_angle_error = best_box.t1 - best_box.t0;
+      Candidate c = refineSeed(map, best.pose, readings, best.inlier_mask, settings);
+      const Eigen::Vector3d moved = poseDifference(c.pose, best.pose);
+      // Kept when it stays within two leaves of its start (the polish may slide along a continuum).
+      const bool near = moved.head<2>().norm() <= 2.0 * (leaf.box.x1 - leaf.box.x0) &&
+                        std::abs(moved.z()) <= 2.0 * (leaf.box.t1 - leaf.box.t0);
+      Candidate& found = near && betterCandidate(c, best) ? c : best;
+      refined = betterCandidate(found, refined) ? found : refined;
+      if (netConsensus(refined) >= target)
+      {
+        break;
+      }
+    }
+    level = std::move(next);
+  }
+  return refined;
+}
+
+}  // namespace core
+}  // namespace fdml_localization

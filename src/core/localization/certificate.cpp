@@ -143,21 +143,11 @@ void certifyVoxels(const MapRayCaster& map, const std::vector<Reading>& readings
   {
     const std::vector<VoxelCluster> clusters = connectedComponents(spec, count, bound);
     regions.count = static_cast<int>(clusters.size());
-    const double dt = spec.thetaStep();
     for (std::size_t c = 0; c < clusters.size(); ++c)
     {
       for (const std::size_t v : clusters[c].voxels)
       {
-        int ix = 0, iy = 0, it = 0;
-        spec.unindex(v, ix, iy, it);
-        PoseBox box;
-        box.x0 = spec.origin_x + ix * spec.cell;
-        box.x1 = box.x0 + spec.cell;
-        box.y0 = spec.origin_y + iy * spec.cell;
-        box.y1 = box.y0 + spec.cell;
-        box.t0 = -kPi + it * dt;
-        box.t1 = box.t0 + dt;
-        regions.boxes.push_back(box);
+        regions.boxes.push_back(voxelBox(spec, v));
         regions.region.push_back(static_cast<int>(c));
       }
     }

@@ -120,59 +120,83 @@ TEST_P(PastMisses, TheTruthIsAmongTheCandidates)
   }
 }
 
-/// `verify_localization --seed 12 --map` on the bundled apartment, office, warehouse, corridor and
-/// twin rooms (map 0 to 4), adaptive engine: places alike enough to explain every reading exactly
-/// in other rooms, the truth's region of leaves never searched (eighth round), at the resolution
-/// given.
-const std::pair<const char*, int> kBundledMapMisses[] = {
-  { "driving map 0 k 8 exact truth (8.2526983011685893, 7.9334442982228222, -2.6402727739307008)", 64 },
-  { "driving map 1 k 5 exact truth (10.873324094953373, 5.3714532246066442, 2.1507186343062079)", 64 },
-  { "driving map 3 k 12 exact truth (14.52162645313294, 2.4828448413602198, -0.96253437142145559)", 64 },
-  { "driving map 4 k 19 exact truth (7.7301696225905774, 2.2502353844054599, -0.87505177060145778)", 64 },
-  // Its first leaf's lattice refined to 18 of 19 readings 20 cm off: the region's next leaves.
-  { "driving map 4 k 19 exact truth (7.7301696225905774, 2.2502353844054599, -0.87505177060145778)", 100 },
-  // Places a few centimetres wide (rays grazing corners, short no-return ranges): a lattice of
-  // the whole leaf missed them, its sub-boxes find them (placeInLeaf()).
-  { "no-return map 3 k 6 exact truth (28.815830908199356, 1.4852962530705711, -0.17167784249120377) max range "
-    "1.6688911968678346",
-    64 },
-  { "grazing map 2 k 4 exact truth (46.562916255942653, 16.175495375141647, -3.076620637229539)", 64 },
-  { "no-return map 3 k 13 exact truth (26.381324822881957, 3.2407633198925927, 2.7078959297860861) max range "
-    "2.3637228013511424",
-    64 },
-  { "no-return map 3 k 8 exact truth (35.555483879919223, 1.7816582839538329, -3.087170903859112) max range "
-    "1.4254066600452902",
-    64 },
-  // 377 regions at the consensus in the warehouse: the truth's beyond the first 64 leaves.
-  { "driving map 2 k 14 exact truth (17.908513613491316, 2.8717682647806093, -2.4908945036314423)", 64 },
-  // The best candidate (23 of 30) lay on a corridor continuum holding the truth (30 of 30): a
-  // leaf that may beat the best candidate is searched even where a candidate accounts for it.
-  { "driving map 3 k 30 exact truth (11.905795181301755, 2.2109756034548846, -0.78963964898705941)", 64 },
-  // An approximate candidate's continuum (sd 40 m along the corridor) reached the exact truth's
-  // leaf: such leaves are searched after the others, and a place there joins when it is better.
-  { "driving map 3 k 5 exact truth (6.8620198920421416, 2.6024230434802158, -0.10970389281797122)", 64 },
+/// A past miss on a bundled map: the trial, the resolution and the engine that missed it.
+struct BundledMiss
+{
+  const char* label;
+  int resolution;
+  Engine engine;
 };
 
-TEST(PastMissesOnBundledMaps, TheAdaptiveEngineSearchesEveryRegionReachingTheConsensus)
+/// `verify_localization --seed 12 --map` on the bundled apartment, office, warehouse, corridor and
+/// twin rooms (map 0 to 4): places alike enough to explain every reading exactly in other rooms,
+/// the truth's region of leaves never searched (eighth round), places missed inside regions and
+/// the voxel engine's (ninth round).
+const BundledMiss kBundledMapMisses[] = {
+  { "driving map 0 k 8 exact truth (8.2526983011685893, 7.9334442982228222, -2.6402727739307008)", 64,
+    Engine::Adaptive },
+  { "driving map 1 k 5 exact truth (10.873324094953373, 5.3714532246066442, 2.1507186343062079)", 64,
+    Engine::Adaptive },
+  { "driving map 3 k 12 exact truth (14.52162645313294, 2.4828448413602198, -0.96253437142145559)", 64,
+    Engine::Adaptive },
+  { "driving map 4 k 19 exact truth (7.7301696225905774, 2.2502353844054599, -0.87505177060145778)", 64,
+    Engine::Adaptive },
+  // Its first leaf's lattice refined to 18 of 19 readings 20 cm off: the region's next leaves.
+  { "driving map 4 k 19 exact truth (7.7301696225905774, 2.2502353844054599, -0.87505177060145778)", 100,
+    Engine::Adaptive },
+  // Places a few centimetres wide (rays grazing corners, short no-return ranges): a lattice of
+  // the whole leaf missed them, its sub-boxes find them (searchLeafForPlace()).
+  { "no-return map 3 k 6 exact truth (28.815830908199356, 1.4852962530705711, -0.17167784249120377) max range "
+    "1.6688911968678346",
+    64, Engine::Adaptive },
+  { "grazing map 2 k 4 exact truth (46.562916255942653, 16.175495375141647, -3.076620637229539)", 64,
+    Engine::Adaptive },
+  { "no-return map 3 k 13 exact truth (26.381324822881957, 3.2407633198925927, 2.7078959297860861) max range "
+    "2.3637228013511424",
+    64, Engine::Adaptive },
+  { "no-return map 3 k 8 exact truth (35.555483879919223, 1.7816582839538329, -3.087170903859112) max range "
+    "1.4254066600452902",
+    64, Engine::Adaptive },
+  // 377 regions at the consensus in the warehouse: the truth's beyond the first 64 leaves.
+  { "driving map 2 k 14 exact truth (17.908513613491316, 2.8717682647806093, -2.4908945036314423)", 64,
+    Engine::Adaptive },
+  // The best candidate (23 of 30) lay on a corridor continuum holding the truth (30 of 30): a
+  // leaf that may beat the best candidate is searched even where a candidate accounts for it.
+  { "driving map 3 k 30 exact truth (11.905795181301755, 2.2109756034548846, -0.78963964898705941)", 64,
+    Engine::Adaptive },
+  // An approximate candidate's continuum (sd 40 m along the corridor) reached the exact truth's
+  // leaf: such leaves are searched after the others, and a place there joins when it is better.
+  { "driving map 3 k 5 exact truth (6.8620198920421416, 2.6024230434802158, -0.10970389281797122)", 64,
+    Engine::Adaptive },
+  // The voxel engine's seeds reached one place of a region and the conservative count's regions
+  // are large: its voxels are searched as the adaptive engine's leaves are (region fill).
+  { "turning map 3 k 6 exact truth (33.673439867676187, 2.2782635173106898, -1.6316352494728594)", 64, Engine::Voxel },
+  { "no-return map 3 k 10 exact truth (31.138794464112824, 4.0241664467821749, 1.1005689745029175) max range "
+    "1.2078923444231138",
+    64, Engine::Voxel },
+  { "driving map 1 k 5 exact truth (10.873324094953373, 5.3714532246066442, 2.1507186343062079)", 64, Engine::Voxel },
+};
+
+TEST(PastMissesOnBundledMaps, BothEnginesSearchEveryRegionReachingTheConsensus)
 {
   std::vector<std::shared_ptr<const MapRayCaster>> maps;
   for (const char* name : { "apartment", "office", "warehouse", "corridor", "twin_rooms" })
   {
     maps.push_back(test::loadMap(std::string("maps/") + name + ".poly"));
   }
-  for (const auto& miss : kBundledMapMisses)
+  for (const BundledMiss& miss : kBundledMapMisses)
   {
-    const verification::Trial trial = trialFrom(miss.first, maps);
+    const verification::Trial trial = trialFrom(miss.label, maps);
     LocalizerOptions options;
-    options.engine = Engine::Adaptive;
-    options.resolution = miss.second;
+    options.engine = miss.engine;
+    options.resolution = miss.resolution;
     options.threads = 1;
     Localizer localizer(maps[static_cast<std::size_t>(trial.map)], options);
     verification::Figures figures;
-    verification::checkNoiseFree(localizer, trial, localizer.localize(trial.readings), miss.first, figures);
+    verification::checkNoiseFree(localizer, trial, localizer.localize(trial.readings), miss.label, figures);
     for (const std::string& failure : figures.failures)
     {
-      ADD_FAILURE() << "resolution " << miss.second << ": " << failure;
+      ADD_FAILURE() << toString(miss.engine) << ", resolution " << miss.resolution << ": " << failure;
     }
   }
 }

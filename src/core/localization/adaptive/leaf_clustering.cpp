@@ -284,5 +284,40 @@ std::vector<int> leafComponents(const std::vector<LeafBox>& leaves, int level, s
   return labels;
 }
 
+PoseBox voxelBox(const GridSpec& spec, std::size_t v)
+{
+  int ix = 0, iy = 0, it = 0;
+  spec.unindex(v, ix, iy, it);
+  PoseBox box;
+  box.x0 = spec.origin_x + ix * spec.cell;
+  box.x1 = box.x0 + spec.cell;
+  box.y0 = spec.origin_y + iy * spec.cell;
+  box.y1 = box.y0 + spec.cell;
+  box.t0 = -kPi + it * spec.thetaStep();
+  box.t1 = box.t0 + spec.thetaStep();
+  return box;
+}
+
+std::vector<LeafBox> voxelLeaves(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level)
+{
+  std::vector<LeafBox> leaves;
+  for (std::size_t v = 0; v < count.size(); ++v)
+  {
+    if (count[v] >= level)
+    {
+      LeafBox leaf;
+      leaf.box = voxelBox(spec, v);
+      leaf.count = count[v];
+      int ix = 0, iy = 0, it = 0;
+      spec.unindex(v, ix, iy, it);
+      leaf.ix = ix;
+      leaf.iy = iy;
+      leaf.it = it;
+      leaves.push_back(leaf);
+    }
+  }
+  return leaves;
+}
+
 }  // namespace core
 }  // namespace fdml_localization

@@ -6,6 +6,8 @@
 #include "fdml_localization/core/localization/robust_search.h"
 #include "fdml_localization/core/localization/seed_search.h"
 #include "fdml_localization/core/localization/components.h"
+#include "fdml_localization/core/localization/adaptive/leaf_clustering.h"
+#include "fdml_localization/core/localization/adaptive/region_fill.h"
 #include "fdml_localization/core/localization/hypothesis_seeds.h"
 #include "fdml_localization/core/localization/region_starts.h"
 #include "fdml_localization/core/util/stopwatch.h"
@@ -186,6 +188,24 @@ void VoxelEngine::localizeRobust(const std::vector<Reading>& readings, Result& r
     result.candidates[i].support = static_cast<double>(sizes[i]);
   }
   result.times.components += secondsSince(stage);
+  // The places the seeds missed: the voxels reaching the best candidate's consensus (conservative
+  // count) searched as the adaptive engine's leaves are.
+  const auto fill = std::chrono::steady_clock::now();
+  if (!result.candidates.empty())
+  {
+    const int target = netConsensus(result.candidates.front());
+    std::vector<LeafBox> leaves = voxelLeaves(spec_, count_, target);
+    // The box test bounds a voxel's consensus tighter than the count's distance bounds.
+    for (LeafBox& leaf : leaves)
+    {
+      leaf.count = std::min(leaf.count, boxConsensusBound(*map_, readings, options_.range_tolerance, leaf.box, 0));
+    }
+    leaves.erase(std::remove_if(leaves.begin(), leaves.end(), [&](const LeafBox& l) { return l.count < target; }),
+                 leaves.end());
+    fillUncoveredRegions(*map_, leaves, spec_.nt, readings, options_,
+                         latticeRefinement(options_, spec_.cell, spec_.thetaStep()), result);
+  }
+  result.times.polish += secondsSince(fill);
 }
 
 }  // namespace core

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "fdml_localization/core/localization/adaptive/adaptive_search.h"
+#include "fdml_localization/core/localization/voxel/voxel_grid.h"
 
 #include <cstdint>
 #include <vector>
@@ -44,6 +45,16 @@ std::vector<LeafCluster> leafMaxima(const std::vector<LeafBox>& leaves, int leve
  */
 std::vector<int> leafComponents(const std::vector<LeafBox>& leaves, int level, std::int64_t theta_cells,
                                 int& components);
+
+/// The box of poses of voxel @p v of @p spec: its cell [m] by its heading step [rad] (from -pi).
+PoseBox voxelBox(const GridSpec& spec, std::size_t v);
+
+/**
+ * @brief The voxels whose @p count reaches @p level as leaves (voxelBox(), the count, the voxel's
+ *        indices as the leaf's cell): the voxel engine's cells searched as the adaptive engine's
+ *        leaves are (region_fill.h). Heading cells: spec.nt.
+ */
+std::vector<LeafBox> voxelLeaves(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level);
 
 }  // namespace core
 }  // namespace fdml_localization

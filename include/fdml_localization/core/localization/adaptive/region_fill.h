@@ -1,11 +1,12 @@
 /**
  * @file region_fill.h
- * @brief The adaptive engine's last look at the places its seeds missed (issue 16): the leaves
- *        reaching the best candidate's consensus that hold no candidate are searched through
- *        their sub-boxes (pruned by the box bound), the best verified pose refined; a pose
- *        explaining as many readings as the best candidate (or more) joins the candidates. Where the readings leave a
- * continuum (few finite ranges, alike rooms), one region of leaves can hold several places and the seeds' polish
- *        reaches some and not others; this finds the rest.
+ * @brief Both engines' last look at the places their seeds missed (issue 16): the leaves (the
+ *        voxel engine's voxels as leaves, voxelLeaves()) reaching the best candidate's consensus
+ *        that hold no candidate are searched through their sub-boxes (pruned by the box bound),
+ *        the best verified pose refined; a pose explaining as many readings as the best candidate
+ *        (or more) joins the candidates. Where the readings leave a continuum (few finite ranges,
+ *        alike rooms), one region of leaves can hold several places and the seeds' polish reaches
+ *        some and not others; this finds the rest.
  */
 #pragma once
 

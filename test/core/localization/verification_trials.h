@@ -298,9 +298,15 @@ inline void checkNoiseFree(const Localizer& localizer, const Trial& trial, const
   }
   if (truths == result.candidates.end())
   {
-    // Not a miss when the list is full of candidates at least as good as the truth (ties).
+    // Not a miss when the list is full of candidates at least as good as the truth (ties; exact
+    // places tie whatever their RMS below 1e-6, the rounding of their polish).
+    const auto tiesWithTruth = [&](const Candidate& last) {
+      const bool exact_tie = netConsensus(at_truth) == netConsensus(last) &&
+                             at_truth.contradicted == last.contradicted && last.rms_residual < 1e-6;
+      return exact_tie || !betterCandidate(at_truth, last);
+    };
     const bool tied_out = static_cast<int>(result.candidates.size()) >= localizer.options().max_candidates &&
-                          !betterCandidate(at_truth, result.candidates.back());
+                          tiesWithTruth(result.candidates.back());
     if (!tied_out)
     {
       ++figures.missed;

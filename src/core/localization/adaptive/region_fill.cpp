@@ -9,7 +9,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iterator>
 
 namespace fdml_localization
 {
@@ -25,6 +24,8 @@ constexpr std::size_t kFillLeaves = 20000;
 constexpr int kFillTries = 64;
 /// ... or, beyond those, while the leaves' box tests (searchLeafForPlace()) stay within this many.
 constexpr long kFillBoxTests = 20000;
+/// A place found this many leaves (in x, y and heading) from a candidate is that candidate's.
+constexpr double kNearLeaves = 3.0;
 /// A leaf's centre within this squared Mahalanobis distance of a candidate is its (chi-square,
 /// 3 degrees of freedom, 99 %).
 constexpr double kChiSquare3Dof = 11.34;
@@ -192,12 +193,49 @@ struct FillState
 {
   int target;                    ///< the net consensus a place must reach
   Accounting found;              ///< the places found so far
-  std::vector<Candidate> added;  ///< ... and their candidates
+  std::vector<Candidate> known;  ///< the candidates, then the places found
+  bool changed;                  ///< known changed
   std::vector<char> placed;      ///< per region: a place was found in it
   std::vector<char> searched;    ///< per open leaf
   int tried;                     ///< leaves searched
   long budget;                   ///< box tests left
 };
+
+/// Adds a @p place found in @p leaf to the known candidates, unless one lies within kNearLeaves
+/// leaves of it (at least the uniqueness margins): a place no better than that one is its near-duplicate
+/// (a tie widens that one's covariance to cover it, absorbTiedDuplicates()), a better one
+/// replaces it. Near-duplicates 4 cm and 6 to 9 deg off, listed as places of their own, were
+/// published by the office tracking launch as the pose for moments.
+void admit(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options, double noise,
+           const PoseBox& leaf, Candidate place, FillState& state)
+{
+  place.support = 1.0;
+  widenAlongContinua(map, readings, noise, place);
+  state.found.add(place);
+  state.changed = true;
+  const double near_xy = std::max(options.uniqueness_distance, kNearLeaves * (leaf.x1 - leaf.x0));
+  const double near_theta = std::max(options.uniqueness_angle, kNearLeaves * (leaf.t1 - leaf.t0));
+  for (Candidate& known : state.known)
+  {
+    const Eigen::Vector3d d = poseDifference(place.pose, known.pose);
+    if (d.head<2>().norm() > near_xy || std::abs(d.z()) > near_theta)
+    {
+      continue;
+    }
+    if (betterCandidate(place, known))
+    {
+      known = std::move(place);
+    }
+    else
+    {
+      std::vector<Candidate> kept{ known };
+      absorbTiedDuplicates({ place }, near_xy, near_theta, noise, kept);
+      known.covariance = kept.front().covariance;
+    }
+    return;
+  }
+  state.known.push_back(std::move(place));
+}
 
 /// One pass over the open leaves in @p order. Pass 0 leaves for pass 1 (while the budget lasts)
 /// the leaves of regions holding a place and those on a candidate's continuum: mostly they hold
@@ -236,10 +274,7 @@ void fillPass(const MapRayCaster& map, const std::vector<Reading>& readings, con
     {
       state.target = netConsensus(place);
       state.placed[static_cast<std::size_t>(o.region)] = 1;
-      place.support = 1.0;
-      widenAlongContinua(map, readings, settings.noise_sigma, place);
-      state.found.add(place);
-      state.added.push_back(std::move(place));
+      admit(map, readings, options, settings.noise_sigma, o.leaf->box, std::move(place), state);
     }
   }
 }
@@ -292,7 +327,8 @@ int fillUncoveredRegions(const MapRayCaster& map, const std::vector<LeafBox>& le
   }
   int target = netConsensus(result.candidates.front());
   std::vector<OpenLeaf> open = openLeaves(map, leaves, target, theta_cells, readings, result.candidates, options);
-  FillState state{ target, Accounting(options), {}, {}, std::vector<char>(open.size(), 0), 0, kFillBoxTests };
+  FillState state{ target, Accounting(options), result.candidates, false, {}, std::vector<char>(open.size(), 0),
+                   0,      kFillBoxTests };
   int regions = 0;
   for (const OpenLeaf& o : open)
   {
@@ -304,11 +340,9 @@ int fillUncoveredRegions(const MapRayCaster& map, const std::vector<LeafBox>& le
   {
     fillPass(map, readings, options, settings, open, order, pass, state);
   }
-  std::vector<Candidate>& added = state.added;
-  if (!added.empty())
+  if (state.changed)
   {
-    std::move(added.begin(), added.end(), std::back_inserter(result.candidates));
-    result.candidates = rankAndDeduplicate(std::move(result.candidates), options.uniqueness_distance,
+    result.candidates = rankAndDeduplicate(std::move(state.known), options.uniqueness_distance,
                                            options.uniqueness_angle, options.max_candidates);
   }
   return state.tried;

@@ -108,10 +108,9 @@ struct OpenLeaf
 /// The leaves reaching @p target that hold no candidate's pose (at most kFillLeaves, spread over
 /// them), each with its centre verified, in the order they are searched: round robin over their
 /// connected regions (the best leaf of every region, then the second best, ...; the best centres
-/// first within a rank). A region's place may
-/// lie far from its leaves' centres, on a large map many separate regions reach the consensus
-/// (alike rooms, alcoves), and a continuum's candidate (sd of metres along a corridor) can be an
-/// approximate place while an exact one lies on it.
+/// first within a rank). A region's place may lie far from its leaves' centres, on a large map
+/// many separate regions reach the consensus (alike rooms, alcoves), and a continuum's candidate
+/// (sd of metres along a corridor) can be an approximate place while an exact one lies on it.
 std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<LeafBox>& leaves, int target,
                                  std::int64_t theta_cells, const std::vector<Reading>& readings,
                                  const std::vector<Candidate>& candidates, const LocalizerOptions& options)
@@ -202,10 +201,10 @@ struct FillState
 };
 
 /// Adds a @p place found in @p leaf to the known candidates, unless one lies within kNearLeaves
-/// leaves of it (at least the uniqueness margins): a place no better than that one is its near-duplicate
-/// (a tie widens that one's covariance to cover it, absorbTiedDuplicates()), a better one
-/// replaces it. Near-duplicates 4 cm and 6 to 9 deg off, listed as places of their own, were
-/// published by the office tracking launch as the pose for moments.
+/// leaves of it (at least the uniqueness margins): a place no better than that one is its
+/// near-duplicate (a tie widens that one's covariance to cover it, absorbTiedDuplicates()), a
+/// better one replaces it. A near-duplicate 3 to 5 cm and 6 deg off, listed as a place of its
+/// own, was published by the office tracking launch as the pose for half a second.
 void admit(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options, double noise,
            const PoseBox& leaf, Candidate place, FillState& state)
 {

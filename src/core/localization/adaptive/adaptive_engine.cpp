@@ -94,7 +94,7 @@ public:
     truncated_ = found.truncated;
     times_.preimages += secondsSince(stage);
     stage = std::chrono::steady_clock::now();
-    const std::int64_t theta_cells = std::max<std::int64_t>(1, std::llround(kTwoPi / cell_theta_));
+    const std::int64_t theta_cells = thetaCells(cell_theta_);
     const std::vector<LeafCluster> plateaus = leafMaxima(found.leaves, level, theta_cells);
     times_.components += secondsSince(stage);
     stage = std::chrono::steady_clock::now();
@@ -179,7 +179,7 @@ Result AdaptiveEngine::localize(const std::vector<Reading>& readings)
   }
   result.boxes_per_level = search.result().boxes_per_level;
   result.truncated = search.result().truncated;
-  const std::int64_t theta_cells = std::max<std::int64_t>(1, std::llround(kTwoPi / cell_theta_));
+  const std::int64_t theta_cells = thetaCells(cell_theta_);
   certifyAdaptive(*map_, readings, options_.range_tolerance, search, theta_cells, result);
   last_leaves_ = search.result().leaves;
   result.times.total = secondsSince(start);
@@ -189,7 +189,7 @@ Result AdaptiveEngine::localize(const std::vector<Reading>& readings)
 void AdaptiveEngine::localizeFixed(AdaptiveSearch& search, const std::vector<Reading>& readings, int level,
                                    Result& result)
 {
-  const std::int64_t theta_cells = std::max<std::int64_t>(1, std::llround(kTwoPi / cell_theta_));
+  const std::int64_t theta_cells = thetaCells(cell_theta_);
   const int threads = options_.threads > 0 ? options_.threads : omp_get_max_threads();
   auto stage = std::chrono::steady_clock::now();
   const AdaptiveSearchResult& found = search.run(level);
@@ -231,7 +231,7 @@ void AdaptiveEngine::localizeRobust(AdaptiveSearch& search, const std::vector<Re
   result.candidates = std::move(found.candidates);
   searchNoReturnRegion(search, readings, result);
   const auto stage = std::chrono::steady_clock::now();
-  const std::int64_t theta_cells = std::max<std::int64_t>(1, std::llround(kTwoPi / cell_theta_));
+  const std::int64_t theta_cells = thetaCells(cell_theta_);
   fillUncoveredRegions(*map_, search.result().leaves, theta_cells, readings, options_,
                        latticeRefinement(options_, cell_xy_, cell_theta_), result);
   result.times.polish += secondsSince(stage);

@@ -284,6 +284,11 @@ std::vector<int> leafComponents(const std::vector<LeafBox>& leaves, int level, s
   return labels;
 }
 
+std::int64_t thetaCells(double cell_theta)
+{
+  return std::max<std::int64_t>(1, std::llround(kTwoPi / cell_theta));
+}
+
 PoseBox voxelBox(const GridSpec& spec, std::size_t v)
 {
   int ix = 0, iy = 0, it = 0;

@@ -98,18 +98,15 @@ private:
       const std::vector<bool> hypothesis = engine_.membership(maxima[m].representative, engine_.lastPreimages());
       for (std::size_t j = 0; j < starts[m].size(); ++j)
       {
-        seeds.push_back(seedOf(maxima[m], hypothesis));
+        // The region's retry starts are its first seed's: tried once, not once per seed.
+        seeds.push_back(seedOf(maxima[m], hypothesis, j == 0));
         seeds.back().start = starts[m][j];
-        if (j > 0)
-        {
-          // The region's retry starts are its first seed's: tried once, not once per seed.
-          seeds.back().retry_starts.clear();
-        }
       }
     }
   }
 
-  SearchSeed seedOf(const VoxelCluster& plateau, std::vector<bool> hypothesis) const
+  /// A seed of @p plateau: its free start, retry starts (@p with_retries) and region starts.
+  SearchSeed seedOf(const VoxelCluster& plateau, std::vector<bool> hypothesis, bool with_retries = true) const
   {
     SearchSeed seed;
     const GridSpec& spec = engine_.grid();
@@ -118,9 +115,12 @@ private:
     seed.promised = plateau.peak_count;
     seed.region = plateau.representative;
     const std::size_t n = plateau.voxels.size();
-    for (std::size_t v : { plateau.representative, plateau.voxels[n / 3], plateau.voxels[(2 * n) / 3] })
+    if (with_retries)
     {
-      seed.retry_starts.push_back(freeStart(map_, spec.centre(v), spec.cell));
+      for (std::size_t v : { plateau.representative, plateau.voxels[n / 3], plateau.voxels[(2 * n) / 3] })
+      {
+        seed.retry_starts.push_back(freeStart(map_, spec.centre(v), spec.cell));
+      }
     }
     // The final multi-start's poses, spread over the plateau: it may hold several optima.
     const std::size_t spread = std::min(n, kRegionStarts);

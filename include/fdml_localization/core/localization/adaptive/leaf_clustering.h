@@ -38,6 +38,10 @@ std::vector<LeafCluster> clusterLeaves(const std::vector<LeafBox>& leaves, int l
  */
 std::vector<LeafCluster> leafMaxima(const std::vector<LeafBox>& leaves, int level, std::int64_t theta_cells);
 
+/// The heading cells of @p cell_theta [rad] around the circle (at least 1): the theta_cells of
+/// the functions below for leaves of that size.
+std::int64_t thetaCells(double cell_theta);
+
 /**
  * @brief The connected components (26 neighbours, periodic theta) of the leaves with count >=
  *        @p level: one label per leaf, -1 for the leaves below @p level.

@@ -14,8 +14,12 @@ namespace
 {
 /// Halvings of every axis of the leaf ...
 constexpr int kFillDepth = 4;
-/// ... keeping at most this many sub-boxes per level (the best centres).
+/// ... or up to this many while the best centre is promising (kPromisingSlack) ...
+constexpr int kFillMaxDepth = 6;
+/// ... keeping at most this many sub-boxes per level (the best centres), or this many beyond
+/// kFillDepth.
 constexpr std::size_t kFillBeam = 16;
+constexpr std::size_t kFillDeepBeam = 4;
 
 /// A sub-box of a leaf that may still explain the target, with its centre pose verified.
 struct SubBox
@@ -40,24 +44,39 @@ void keptHalves(const MapRayCaster& map, const std::vector<Reading>& readings, c
   }
 }
 
+/// @p best (the centre of @p best_box) refined, when the refinement stays within two leaves of
+/// it (the polish may slide along a continuum) and is better; else @p best.
+Candidate refinedNear(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
+                      RefinementSettings settings, const PoseBox& leaf, const PoseBox& best_box, const Candidate& best)
+{
+  settings.robust_scale = std::max(options.agreement_tolerance, best_box.x1 - best_box.x0);
+  settings.seed_position_error = best_box.x1 - best_box.x0;
+  settings.seed_angle_error = best_box.t1 - best_box.t0;
+  Candidate c = refineSeed(map, best.pose, readings, best.inlier_mask, settings);
+  const Eigen::Vector3d moved = poseDifference(c.pose, best.pose);
+  const bool near =
+      moved.head<2>().norm() <= 2.0 * (leaf.x1 - leaf.x0) && std::abs(moved.z()) <= 2.0 * (leaf.t1 - leaf.t0);
+  return near && betterCandidate(c, best) ? c : best;
+}
+
 }  // namespace
 
 Candidate searchLeafForPlace(const MapRayCaster& map, const LeafBox& leaf, const Candidate& centre,
                              const std::vector<Reading>& readings, const LocalizerOptions& options,
-                             RefinementSettings settings, int target, long& box_tests)
+                             const RefinementSettings& settings, int target, long& box_tests)
 {
   Candidate best = centre, refined = centre;
   PoseBox best_box = leaf.box;
   bool pending = false;  // best is not refined yet
   std::vector<SubBox> level{ SubBox{ leaf.box, centre } };
-  for (int depth = 1; depth <= kFillDepth && !level.empty(); ++depth)
+  for (int depth = 1; !level.empty(); ++depth)
   {
     std::vector<SubBox> next;
     for (const SubBox& b : level)
     {
       keptHalves(map, readings, options, b.box, target, box_tests, next);
     }
-    const std::size_t beam = std::min(next.size(), kFillBeam);
+    const std::size_t beam = std::min(next.size(), depth > kFillDepth ? kFillDeepBeam : kFillBeam);
     std::partial_sort(next.begin(), next.begin() + static_cast<std::ptrdiff_t>(beam), next.end(),
                       [](const SubBox& a, const SubBox& b) { return betterCandidate(a.centre, b.centre); });
     next.resize(beam);
@@ -67,24 +86,21 @@ Candidate searchLeafForPlace(const MapRayCaster& map, const LeafBox& leaf, const
       best_box = next.front().box;
       pending = true;
     }
-    // Refined near the target, or at the last level: most leaves hold no place.
-    if (pending && !next.empty() && (netConsensus(best) >= target - kPromisingSlack || depth == kFillDepth))
+    const bool promising = netConsensus(best) >= target - kPromisingSlack;
+    // Refined when promising, or from the last regular level on: most leaves hold no place.
+    if (pending && !next.empty() && (promising || depth >= kFillDepth))
     {
       pending = false;
-      settings.robust_scale = std::max(options.agreement_tolerance, best_box.x1 - best_box.x0);
-      settings.seed_position_error = best_box.x1 - best_box.x0;
-      settings.seed_angle_error = best_box.t1 - best_box.t0;
-      Candidate c = refineSeed(map, best.pose, readings, best.inlier_mask, settings);
-      const Eigen::Vector3d moved = poseDifference(c.pose, best.pose);
-      // Kept when it stays within two leaves of its start (the polish may slide along a continuum).
-      const bool near = moved.head<2>().norm() <= 2.0 * (leaf.box.x1 - leaf.box.x0) &&
-                        std::abs(moved.z()) <= 2.0 * (leaf.box.t1 - leaf.box.t0);
-      Candidate& found = near && betterCandidate(c, best) ? c : best;
+      const Candidate found = refinedNear(map, readings, options, settings, leaf.box, best_box, best);
       refined = betterCandidate(found, refined) ? found : refined;
       if (netConsensus(refined) >= target)
       {
         break;
       }
+    }
+    if (depth >= (promising ? kFillMaxDepth : kFillDepth))
+    {
+      break;
     }
     level = std::move(next);
   }

@@ -21,20 +21,22 @@ constexpr int kPromisingSlack = 2;
 
 /**
  * @brief The best pose found in @p leaf for @p target readings: its sub-boxes level by level
- *        (every axis halved, four times: a 75 cm, 5.6 deg leaf down to 4.7 cm and 0.35 deg), only
- *        those that may still explain @p target readings (boxConsensusBound(), range_tolerance),
- *        at most 16 per level (the best verified centres). The best centre so far is refined
- *        (refineSeed() with @p settings, its scales set to the centre's sub-box) once it explains
- *        within two readings of the target, or at the last level, and kept when the refinement
- *        stays within two leaves of it; the search stops at a pose reaching the target. A place
- *        can be a few centimetres wide where rays graze corners or short no-return ranges shape
- *        it: a lattice of the whole leaf misses it.
+ *        (every axis halved, four times: a 75 cm, 5.6 deg leaf down to 4.7 cm and 0.35 deg; six
+ *        times, down to 1.2 cm and 0.09 deg, while the best centre explains within two readings
+ *        of the target), only those that may still explain @p target readings
+ *        (boxConsensusBound(), range_tolerance), at most 16 per level (the best verified
+ *        centres). The best centre so far is refined (refineSeed() with @p settings, its scales
+ *        set to the centre's sub-box) once it explains within two readings of the target, or
+ *        from the fourth level on, and kept when the refinement stays within two leaves of it;
+ *        the search stops at a pose reaching the target. Where rays graze corners or short
+ *        no-return ranges shape it, a place can be a few centimetres or millimetres wide: a
+ *        lattice of the whole leaf misses it.
  * @param centre the leaf's centre, verified (the answer when nothing better is found)
  * @param box_tests counted down by the box tests made (the search of a leaf is never cut)
  */
 Candidate searchLeafForPlace(const MapRayCaster& map, const LeafBox& leaf, const Candidate& centre,
                              const std::vector<Reading>& readings, const LocalizerOptions& options,
-                             RefinementSettings settings, int target, long& box_tests);
+                             const RefinementSettings& settings, int target, long& box_tests);
 
 }  // namespace core
 }  // namespace fdml_localization

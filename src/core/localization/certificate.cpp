@@ -99,19 +99,8 @@ int consensusWithin(const MapRayCaster& map, const Pose2& pose, const std::vecto
   int count = 0;
   for (const Reading& reading : readings)
   {
-    const Pose2 sensor = compose(pose, reading.offset);
-    if (!map.isFree(sensor.position()))
-    {
-      continue;
-    }
-    if (std::isfinite(reading.range))
-    {
-      count += std::abs(predictedRange(map, sensor, reading, kInf) - reading.range) <= tolerance ? 1 : 0;
-    }
-    else
-    {
-      count += predictedRange(map, sensor, reading, reading.max_range + 1.0) >= reading.max_range - tolerance ? 1 : 0;
-    }
+    // NaN (the sensor in a wall) fails the comparison.
+    count += std::abs(readingResidual(map, pose, reading)) <= tolerance ? 1 : 0;
   }
   return count;
 }

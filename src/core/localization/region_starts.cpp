@@ -72,23 +72,11 @@ double agreementScore(const MapRayCaster& map, const Pose2& pose, const std::vec
   double score = 0.0;
   for (const Reading& reading : readings)
   {
-    const Pose2 sensor = compose(pose, reading.offset);
-    double cost = gate * gate;
-    if (map.isFree(sensor.position()))
-    {
-      // A cast need not look beyond where the reading could still agree: the same verdicts
-      // and residuals as evaluatePose(), for much shorter casts where the map reaches far.
-      if (std::isfinite(reading.range))
-      {
-        const double r = predictedRange(map, sensor, reading, reading.range + gate) - reading.range;
-        cost = std::abs(r) < gate ? r * r : cost;
-      }
-      else if (predictedRange(map, sensor, reading, reading.max_range + 1.0) > reading.max_range - gate)
-      {
-        cost = 0.0;
-      }
-    }
-    score += cost;
+    // A cast need not look beyond where the reading could still agree: the verdicts and
+    // residuals of evaluatePose(), for much shorter casts where the map reaches far.
+    const double r = readingResidual(map, pose, reading, gate);
+    const bool agrees = std::abs(r) < gate;  // false for NaN, the sensor in a wall
+    score += !agrees ? gate * gate : std::isfinite(reading.range) ? r * r : 0.0;
   }
   return score;
 }

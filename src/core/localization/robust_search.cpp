@@ -23,6 +23,20 @@ double predictedRange(const MapRayCaster& map, const Pose2& sensor, const Readin
                                     map.range(sensor, max_range);
 }
 
+double readingResidual(const MapRayCaster& map, const Pose2& pose, const Reading& reading, double reach)
+{
+  const Pose2 sensor = compose(pose, reading.offset);
+  if (!map.isFree(sensor.position()))
+  {
+    return kNaN;
+  }
+  if (std::isfinite(reading.range))
+  {
+    return predictedRange(map, sensor, reading, reading.range + reach) - reading.range;
+  }
+  return std::min(0.0, predictedRange(map, sensor, reading, reading.max_range + 1.0) - reading.max_range);
+}
+
 std::vector<double> vertexMargins(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings,
                                   double angle_error)
 {
@@ -65,41 +79,23 @@ PoseEvaluation evaluatePose(const MapRayCaster& map, const Pose2& pose, const st
   int finite_inliers = 0;
   for (std::size_t i = 0; i < readings.size(); ++i)
   {
-    const Reading& reading = readings[i];
-    const Pose2 sensor = compose(pose, reading.offset);
-    if (!map.isFree(sensor.position()))
+    const double r = readingResidual(map, pose, readings[i]);
+    if (std::isnan(r))
     {
       continue;
     }
-    if (std::isfinite(reading.range))
+    const bool finite = std::isfinite(readings[i].range);
+    eval.residuals[i] = finite ? r : kNaN;
+    if (std::abs(r) < eps)
     {
-      const double h = predictedRange(map, sensor, reading, kInf);
-      const double r = h - reading.range;
-      eval.residuals[i] = r;
-      if (std::abs(r) < eps)
-      {
-        eval.inlier_mask[i] = true;
-        ++eval.inliers;
-        sum_sq += r * r;
-        ++finite_inliers;
-      }
-      else if (r < 0.0)
-      {
-        ++eval.contradicted;
-      }
+      eval.inlier_mask[i] = true;
+      ++eval.inliers;
+      sum_sq += finite ? r * r : 0.0;
+      finite_inliers += finite ? 1 : 0;
     }
-    else
+    else if (r < 0.0)
     {
-      const double h = predictedRange(map, sensor, reading, reading.max_range + 1.0);
-      if (h > reading.max_range - eps)
-      {
-        eval.inlier_mask[i] = true;
-        ++eval.inliers;
-      }
-      else
-      {
-        ++eval.contradicted;
-      }
+      ++eval.contradicted;
     }
   }
   eval.rms = finite_inliers > 0 ? std::sqrt(sum_sq / finite_inliers) : 0.0;

@@ -1,7 +1,10 @@
 // region_starts.h: the agreement score with casts cut at d + gate against the same score from
 // evaluatePose()'s full casts (rays, cones and no-return readings, poses in and out of free
-// space), and seed starts moved off the walls.
+// space), the one residual rule of every count of agreeing readings, and seed starts moved off
+// the walls.
 #include "fdml_localization/core/localization/region_starts.h"
+
+#include "fdml_localization/core/localization/certificate.h"
 
 #include "localizer_test_utils.h"
 
@@ -65,6 +68,32 @@ TEST(RegionStarts, AgreementScoreEqualsTheFullCastScore)
     }
   }
   EXPECT_GT(agreeing, 300);  // poses where some readings agree were tested
+}
+
+TEST(RegionStarts, OneResidualRuleForEveryCountOfAgreeingReadings)
+{
+  // The square room's east wall is x = 1: a ray east from (0.3, 0.2) meets it at 0.7 m.
+  const auto map = test::loadMap("maps/square_room.poly");
+  const Pose2 pose(0.3, 0.2, 0.0);
+  Reading finite;
+  finite.range = 0.6;
+  EXPECT_NEAR(readingResidual(*map, pose, finite), 0.1, 1e-12);
+  EXPECT_EQ(readingResidual(*map, pose, finite, 0.05), kInf);  // the cast cut at d + reach
+  Reading no_return;
+  no_return.range = kInf;
+  no_return.max_range = 0.5;  // nothing within 0.5 m, as measured
+  EXPECT_EQ(readingResidual(*map, pose, no_return), 0.0);
+  no_return.max_range = 0.9;  // the wall at 0.7 m should have returned
+  EXPECT_NEAR(readingResidual(*map, pose, no_return), -0.2, 1e-12);
+  EXPECT_TRUE(std::isnan(readingResidual(*map, Pose2(1.5, 0.0, 0.0), finite)));  // outside
+  // Its consumers: agreeing within eps when |r| < eps, contradicted when r <= -eps; the
+  // certificate's count includes |r| = tolerance.
+  const std::vector<Reading> readings{ finite, no_return };
+  const PoseEvaluation e = evaluatePose(*map, pose, readings, 0.15);
+  EXPECT_EQ(e.inliers, 1);
+  EXPECT_EQ(e.contradicted, 1);
+  EXPECT_EQ(consensusWithin(*map, pose, readings, 0.2 + 1e-9), 2);
+  EXPECT_NEAR(agreementScore(*map, pose, readings, 0.15), 0.1 * 0.1 + 0.15 * 0.15, 1e-12);
 }
 
 TEST(RegionStarts, FreeStartMovesAStartInAWallIntoFreeSpace)

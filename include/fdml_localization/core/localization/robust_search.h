@@ -40,6 +40,17 @@ struct PoseEvaluation
 double predictedRange(const MapRayCaster& map, const Pose2& sensor, const Reading& reading, double max_range);
 
 /**
+ * @brief @p reading's residual at robot pose @p pose [m], the one rule every count of agreeing
+ *        readings applies (evaluatePose(), consensusWithin(), agreementScore()): h - d for a
+ *        finite range (h: predictedRange(), looking no further than d + @p reach, +inf beyond);
+ *        for a no-return reading, min(0, h - max_range) (0: nothing within its range, as
+ *        measured). NaN when the sensor lies outside free space. The reading agrees within eps
+ *        when |residual| < eps; it is contradicted when residual <= -eps (measured longer than
+ *        the map allows, which no unknown obstacle explains).
+ */
+double readingResidual(const MapRayCaster& map, const Pose2& pose, const Reading& reading, double reach = kInf);
+
+/**
  * @brief Verifies @p pose: reading i agrees when its sensor position q (+) g_i is in free
  *        space and |h(q (+) g_i) - d_i| < eps (h: predictedRange(), the cone cast for a cone
  *        reading), or, for a no-return reading (d_i = +inf),

@@ -23,7 +23,7 @@ constexpr std::size_t kFillLeaves = 20000;
 /// ... at least this many of them (where as many are open) ...
 constexpr int kFillTries = 64;
 /// ... or, beyond those, while the leaves' box tests (searchLeafForPlace()) stay within this many.
-constexpr long kFillBoxTests = 25000;
+constexpr long kFillBoxTests = 50000;
 /// A place found this many leaves (in x, y and heading) from a candidate is that candidate's.
 constexpr double kNearLeaves = 3.0;
 /// A leaf's centre within this squared Mahalanobis distance of a candidate is its (chi-square,

@@ -189,6 +189,16 @@ const BundledMiss kBundledMapMisses[] = {
   // the place found.
   { "driving map 3 k 30 exact truth (11.905795181301755, 2.2109756034548846, -0.78963964898705941)", 100,
     Engine::Voxel },
+  // Seed 21: 1,771 and 8,495 open leaves (k = 4; 23 of 28 readings no-return), the truth's
+  // leaf came after 25,000 box tests of searches: the fill's budget is 50,000.
+  { "driving map 2 k 4 exact truth (27.832236083377907, 26.299654884994535, -1.364435718165276)", 64,
+    Engine::Adaptive },
+  { "no-return map 2 k 28 exact truth (43.446458128103501, 15.189687320011892, -1.1998514624967069) max range "
+    "1.0353460052190651",
+    64, Engine::Voxel },
+  { "no-return map 3 k 7 exact truth (21.030635415184232, 2.7043266018754242, -2.5368368866152013) max range "
+    "1.6076546003827812",
+    64, Engine::Voxel },
 };
 
 TEST(PastMissesOnBundledMaps, BothEnginesSearchEveryRegionReachingTheConsensus)

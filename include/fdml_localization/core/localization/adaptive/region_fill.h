@@ -50,9 +50,9 @@ RefinementSettings latticeRefinement(const LocalizerOptions& options, double cel
  *        when their centre explains within two readings of the consensus), then, while the
  *        budget lasts, the leaves left: of regions holding a place, and on a continuum (a place
  *        there joins only when better than that candidate). At least 64 leaves, more while
- *        their box tests stay within 20,000. Each leaf is searched through its sub-boxes (every
- *        axis halved four times, only halves whose boxConsensusBound() reaches the target, the
- *        best 16 per level), the best centre refined with @p settings scaled to its sub-box.
+ *        their box tests stay within 50,000. Each leaf is searched through its sub-boxes
+ *        (searchLeafForPlace()), the best centre refined with @p settings scaled to its sub-box,
+ *        and again for one reading more while its bound exceeds the place found.
  * @return the leaves searched
  */
 int fillUncoveredRegions(const MapRayCaster& map, const std::vector<LeafBox>& leaves, std::int64_t theta_cells,

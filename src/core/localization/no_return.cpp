@@ -1,6 +1,7 @@
 #include "fdml_localization/core/localization/no_return.h"
 
 #include "fdml_localization/core/localization/ranking.h"
+#include "fdml_localization/core/localization/robust_search.h"
 
 #include <algorithm>
 #include <cmath>
@@ -63,18 +64,14 @@ std::vector<Reading> readingsWithReturn(const std::vector<Reading>& readings, co
 
 namespace
 {
-/// No-returns agreeing with the map at @p pose (no wall within max_range - eps), as constraint does.
+/// No-returns agreeing with the map at @p pose (no wall within max_range - eps, the cone's nearest
+/// for a cone: readingResidual()), as constraint does.
 int agreeingNoReturns(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings, double eps)
 {
   int agree = 0;
   for (const Reading& r : readings)
   {
-    if (std::isfinite(r.range))
-    {
-      continue;
-    }
-    const Pose2 sensor = compose(pose, r.offset);
-    agree += map.isFree(sensor.position()) && map.range(sensor, r.max_range + 1.0) > r.max_range - eps;
+    agree += !std::isfinite(r.range) && std::abs(readingResidual(map, pose, r)) < eps ? 1 : 0;
   }
   return agree;
 }

@@ -256,6 +256,12 @@ PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std:
   return out;
 }
 
+Eigen::Matrix3d covarianceAt(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings,
+                             const std::vector<bool>& use, double noise_sigma)
+{
+  return polishPose(map, pose, readings, use, 0.0, 0, noise_sigma).covariance;
+}
+
 Eigen::Matrix3d oneDirectionLostCovariance(const MapRayCaster& map, const Pose2& pose,
                                            const std::vector<Reading>& readings, const std::vector<bool>& use,
                                            double noise_sigma, double group_angle)

@@ -215,7 +215,11 @@ void Refiner::polishRounds()
 Candidate Refiner::candidate() const
 {
   Candidate c = candidateFrom(best_pose_, best_);
-  c.covariance = best_cov_;
+  // The seed itself, when no polish beat it (no three finite readings to polish on, or an exact
+  // start), has no covariance yet: a zero one would be a false certainty.
+  c.covariance = best_cov_.isZero() ?
+                     covarianceAt(map_, best_pose_, readings_, best_.inlier_mask, settings_.noise_sigma) :
+                     best_cov_;
   return c;
 }
 

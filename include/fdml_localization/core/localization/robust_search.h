@@ -99,6 +99,14 @@ PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std:
                          const PosePrior& prior = PosePrior());
 
 /**
+ * @brief The covariance polishPose() would give at @p pose (no step taken) [m^2, rad^2]: for a
+ *        candidate that is a verified pose, never polished (a lattice or sub-box centre), so
+ *        that no candidate leaves with a zero covariance (a false certainty).
+ */
+Eigen::Matrix3d covarianceAt(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings,
+                             const std::vector<bool>& use, double noise_sigma);
+
+/**
  * @brief What the covariance of @p pose (from the finite readings selected by @p use, as
  *        polishPose() computes it) gains when the readings of one direction are all wrong: a
  *        person in front of one sensor, or hiding a sector of a scanner, shifts every reading

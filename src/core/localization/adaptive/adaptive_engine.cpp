@@ -240,15 +240,14 @@ void AdaptiveEngine::localizeRobust(AdaptiveSearch& search, const std::vector<Re
 void AdaptiveEngine::searchNoReturnRegion(const AdaptiveSearch& search, const std::vector<Reading>& readings,
                                           Result& result) const
 {
-  if (result.candidates.empty())
-  {
-    return;
-  }
-  const Candidate& best = result.candidates.front();
+  // No candidate at all is possible: where every reading is a no-return, the seeds' plateau is
+  // the whole free space and the few poses clear of walls in every sensor's range can escape
+  // its sampled leaves (4 no-returns with a 2.3 m range in the warehouse).
+  const int best_net = result.candidates.empty() ? -1 : netConsensus(result.candidates.front());
   const int bound = search.consensusBound();
   const bool no_returns =
       std::any_of(readings.begin(), readings.end(), [](const Reading& r) { return !std::isfinite(r.range); });
-  if (!no_returns || netConsensus(best) >= bound)
+  if (!no_returns || best_net >= bound)
   {
     return;
   }
@@ -266,19 +265,28 @@ void AdaptiveEngine::searchNoReturnRegion(const AdaptiveSearch& search, const st
   std::partial_sort(lattice_best.begin(), lattice_best.begin() + static_cast<std::ptrdiff_t>(refined),
                     lattice_best.end(), betterCandidate);
   const RefinementSettings settings = latticeRefinement(options_, cell_xy_, cell_theta_);
-  Candidate found = best;
+  Candidate found;
+  int found_net = best_net;
   for (std::size_t i = 0; i < refined; ++i)
   {
     const Candidate& start = lattice_best[i];
     Candidate c = refineSeed(*map_, start.pose, readings, start.inlier_mask, settings);
     Candidate& better = betterCandidate(c, start) ? c : lattice_best[i];
-    if (netConsensus(better) > netConsensus(found))
+    if (netConsensus(better) > found_net)
     {
       found = better;
+      found_net = netConsensus(better);
     }
   }
-  if (netConsensus(found) > netConsensus(best))
+  if (found_net > best_net)
   {
+    if (found.covariance.isZero())
+    {
+      found.covariance = covarianceAt(*map_, found.pose, readings, found.inlier_mask, settings.noise_sigma);
+    }
+    widenAlongContinua(*map_, readings, settings.noise_sigma, found);
+    // An automatic k' is the largest consensus found.
+    result.min_inliers_used = options_.min_inliers > 0 ? result.min_inliers_used : found_net;
     result.candidates.insert(result.candidates.begin(), std::move(found));
     result.candidates = rankAndDeduplicate(std::move(result.candidates), options_.uniqueness_distance,
                                            options_.uniqueness_angle, options_.max_candidates);

@@ -104,6 +104,10 @@ Candidate searchLeafForPlace(const MapRayCaster& map, const LeafBox& leaf, const
     }
     level = std::move(next);
   }
+  if (refined.covariance.isZero())
+  {
+    refined.covariance = covarianceAt(map, refined.pose, readings, refined.inlier_mask, settings.noise_sigma);
+  }
   return refined;
 }
 

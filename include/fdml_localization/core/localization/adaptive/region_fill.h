@@ -48,11 +48,14 @@ RefinementSettings latticeRefinement(const LocalizerOptions& options, double cel
  *        @p theta_cells heading cells around the circle: every region's best leaf by its centre,
  *        then its second, ..., further leaves only while no place was found in the region or
  *        when their centre explains within two readings of the consensus), then, while the
- *        budget lasts, the leaves left: of regions holding a place, and on a continuum (a place
- *        there joins only when better than that candidate). At least 64 leaves, more while
- *        their box tests stay within 50,000. Each leaf is searched through its sub-boxes
- *        (searchLeafForPlace()), the best centre refined with @p settings scaled to its sub-box,
- *        and again for one reading more while its bound exceeds the place found.
+ *        budget lasts, the leaves left: of regions holding a place, on a candidate's continuum,
+ *        and those a place found by this fill lies in or whose centre its continuum reaches (a
+ *        place there joins only when better than that candidate or place: the first place found
+ *        in a region can be a local optimum of the residual). At least 64 leaves, more while
+ *        their box tests stay within 50,000, and 50,000 more for leaves whose bound exceeds the
+ *        best place found (the answer then provably incomplete). Each leaf is searched through
+ *        its sub-boxes (searchLeafForPlace()), the best centre refined with @p settings scaled to
+ *        its sub-box, and again for one reading more while its bound exceeds the place found.
  * @return the leaves searched
  */
 int fillUncoveredRegions(const MapRayCaster& map, const std::vector<LeafBox>& leaves, std::int64_t theta_cells,

@@ -23,7 +23,7 @@ constexpr std::size_t kFillLeaves = 20000;
 /// ... at least this many of them (where as many are open) ...
 constexpr int kFillTries = 64;
 /// ... or, beyond those, while the leaves' box tests (searchLeafForPlace()) stay within this many.
-constexpr long kFillBoxTests = 50000;
+constexpr long kFillBoxTests = 100000;
 /// Leaves whose bound exceeds the best place found (the answer then provably incomplete) may
 /// spend this many more: many no-returns of a short range leave thousands of such leaves.
 constexpr long kBeyondBoxTests = 50000;

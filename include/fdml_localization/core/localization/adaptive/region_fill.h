@@ -52,7 +52,7 @@ RefinementSettings latticeRefinement(const LocalizerOptions& options, double cel
  *        and those a place found by this fill lies in or whose centre its continuum reaches (a
  *        place there joins only when better than that candidate or place: the first place found
  *        in a region can be a local optimum of the residual). At least 64 leaves, more while
- *        their box tests stay within 50,000, and 50,000 more for leaves whose bound exceeds the
+ *        their box tests stay within 100,000, and 50,000 more for leaves whose bound exceeds the
  *        best place found (the answer then provably incomplete). Each leaf is searched through
  *        its sub-boxes (searchLeafForPlace()), the best centre refined with @p settings scaled to
  *        its sub-box, and again for one reading more while its bound exceeds the place found.

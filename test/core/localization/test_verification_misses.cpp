@@ -190,8 +190,8 @@ const BundledMiss kBundledMapMisses[] = {
   { "driving map 3 k 30 exact truth (11.905795181301755, 2.2109756034548846, -0.78963964898705941)", 100,
     Engine::Voxel },
   // Seed 21: 1,771 and 8,495 open leaves (k = 4; 23 of 28 readings no-return), the truth's
-  // leaf came after 25,000 box tests of searches: the fill's budget became 50,000 (tenth round; 100,000 since the
-  // eleventh).
+  // leaf came after 25,000 box tests of searches: the fill's budget became 50,000 (tenth round;
+  // 100,000 since the eleventh).
   { "driving map 2 k 4 exact truth (27.832236083377907, 26.299654884994535, -1.364435718165276)", 64,
     Engine::Adaptive },
   { "no-return map 2 k 28 exact truth (43.446458128103501, 15.189687320011892, -1.1998514624967069) max range "

@@ -256,10 +256,14 @@ PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std:
   return out;
 }
 
-Eigen::Matrix3d covarianceAt(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings,
-                             const std::vector<bool>& use, double noise_sigma)
+void ensureCovariance(const MapRayCaster& map, const std::vector<Reading>& readings, double noise_sigma,
+                      Candidate& candidate)
 {
-  return polishPose(map, pose, readings, use, 0.0, 0, noise_sigma).covariance;
+  if (candidate.covariance.isZero())
+  {
+    candidate.covariance =
+        polishPose(map, candidate.pose, readings, candidate.inlier_mask, 0.0, 0, noise_sigma).covariance;
+  }
 }
 
 Eigen::Matrix3d oneDirectionLostCovariance(const MapRayCaster& map, const Pose2& pose,

@@ -217,9 +217,8 @@ Candidate Refiner::candidate() const
   Candidate c = candidateFrom(best_pose_, best_);
   // The seed itself, when no polish beat it (no three finite readings to polish on, or an exact
   // start), has no covariance yet: a zero one would be a false certainty.
-  c.covariance = best_cov_.isZero() ?
-                     covarianceAt(map_, best_pose_, readings_, best_.inlier_mask, settings_.noise_sigma) :
-                     best_cov_;
+  c.covariance = best_cov_;
+  ensureCovariance(map_, readings_, settings_.noise_sigma, c);
   return c;
 }
 

@@ -221,12 +221,8 @@ private:
 #pragma omp parallel for schedule(dynamic, 1) num_threads(ctx_.threads) if (kept.size() >= 2)
     for (std::size_t j = 0; j < kept.size(); ++j)
     {
-      if (kept[j].covariance.isZero())
-      {
-        // A seed's start no refinement beat (an exact start, or no three finite readings).
-        kept[j].covariance =
-            covarianceAt(ctx_.map, kept[j].pose, ctx_.readings, kept[j].inlier_mask, ctx_.settings.noise_sigma);
-      }
+      // A seed's start no refinement beat (an exact start, or no three finite readings).
+      ensureCovariance(ctx_.map, ctx_.readings, ctx_.settings.noise_sigma, kept[j]);
       if (netConsensus(kept[j]) < top)
       {
         widenAlongContinua(ctx_.map, ctx_.readings, ctx_.settings.noise_sigma, kept[j]);

@@ -99,12 +99,14 @@ PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std:
                          const PosePrior& prior = PosePrior());
 
 /**
- * @brief The covariance polishPose() would give at @p pose (no step taken) [m^2, rad^2]: for a
- *        candidate that is a verified pose, never polished (a lattice or sub-box centre), so
- *        that no candidate leaves with a zero covariance (a false certainty).
+ * @brief Gives @p candidate, when its covariance is zero (a verified pose no polish moved: a
+ *        seed's start, a lattice or sub-box centre), the covariance polishPose() would give at
+ *        its pose over its inliers (no step taken) [m^2, rad^2]: no candidate leaves with a zero
+ *        covariance, a false certainty.
+ * @param noise_sigma lower bound on the residual standard deviation [m], as in polishPose()
  */
-Eigen::Matrix3d covarianceAt(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings,
-                             const std::vector<bool>& use, double noise_sigma);
+void ensureCovariance(const MapRayCaster& map, const std::vector<Reading>& readings, double noise_sigma,
+                      Candidate& candidate);
 
 /**
  * @brief What the covariance of @p pose (from the finite readings selected by @p use, as

@@ -280,10 +280,7 @@ void AdaptiveEngine::searchNoReturnRegion(const AdaptiveSearch& search, const st
   }
   if (found_net > best_net)
   {
-    if (found.covariance.isZero())
-    {
-      found.covariance = covarianceAt(*map_, found.pose, readings, found.inlier_mask, settings.noise_sigma);
-    }
+    ensureCovariance(*map_, readings, settings.noise_sigma, found);
     widenAlongContinua(*map_, readings, settings.noise_sigma, found);
     // An automatic k' is the largest consensus found.
     result.min_inliers_used = options_.min_inliers > 0 ? result.min_inliers_used : found_net;

@@ -104,10 +104,7 @@ Candidate searchLeafForPlace(const MapRayCaster& map, const LeafBox& leaf, const
     }
     level = std::move(next);
   }
-  if (refined.covariance.isZero())
-  {
-    refined.covariance = covarianceAt(map, refined.pose, readings, refined.inlier_mask, settings.noise_sigma);
-  }
+  ensureCovariance(map, readings, settings.noise_sigma, refined);
   return refined;
 }
 

@@ -2,6 +2,7 @@
 // shared robust search (seed_search.h), or verified component centres (paper, baseline).
 #include "fdml_localization/core/localization/adaptive/adaptive_engine.h"
 
+#include "fdml_localization/core/localization/adaptive/leaf_search.h"
 #include "fdml_localization/core/localization/adaptive/region_fill.h"
 #include "fdml_localization/core/localization/certificate.h"
 #include "fdml_localization/core/localization/ranking.h"

@@ -21,6 +21,9 @@ constexpr int kFillMaxDepth = 6;
 constexpr std::size_t kFillBeam = 16;
 constexpr std::size_t kFillDeepBeam = 4;
 
+/// Deepest sub-boxes a screen verifies (screenLeaf()).
+constexpr std::size_t kScreenVerified = 8;
+
 /// A sub-box of a leaf that may still explain the target, with its centre pose verified.
 struct SubBox
 {
@@ -106,6 +109,74 @@ Candidate searchLeafForPlace(const MapRayCaster& map, const LeafBox& leaf, const
   }
   ensureCovariance(map, readings, settings.noise_sigma, refined);
   return refined;
+}
+
+bool screenLeaf(const MapRayCaster& map, const PoseBox& leaf, const std::vector<Reading>& readings,
+                const LocalizerOptions& options, int needed, int depth, Candidate& centre, long& box_tests)
+{
+  std::vector<PoseBox> level{ leaf };
+  for (int d = 0; d < depth && !level.empty(); ++d)
+  {
+    std::vector<PoseBox> next;
+    for (const PoseBox& box : level)
+    {
+      for (int c = 0; c < 8; ++c)
+      {
+        --box_tests;
+        if (boxConsensusBound(map, readings, options.range_tolerance, box.half(c), needed) >= needed)
+        {
+          next.push_back(box.half(c));
+        }
+      }
+    }
+    level = std::move(next);
+  }
+  const std::size_t step = std::max<std::size_t>(1, level.size() / kScreenVerified);
+  for (std::size_t j = 0; j < level.size(); j += step)
+  {
+    Candidate c = verifiedCandidate(map, level[j].centre(), readings, options.agreement_tolerance);
+    if (centre.inliers < 0 || betterCandidate(c, centre))
+    {
+      centre = std::move(c);
+    }
+  }
+  return !level.empty();
+}
+
+std::vector<Candidate> leafLatticeBests(const MapRayCaster& map, const std::vector<const LeafBox*>& leaves,
+                                        std::size_t max_leaves, const std::vector<Reading>& readings, double eps)
+{
+  const std::size_t step = std::max<std::size_t>(1, leaves.size() / std::max<std::size_t>(1, max_leaves));
+  const auto at = [](double lo, double hi, int j) { return lo + (hi - lo) * (j + 0.5) / kLeafLattice; };
+  std::vector<Candidate> lattice_best;
+  for (std::size_t l = 0; l < leaves.size(); l += step)
+  {
+    const PoseBox& b = leaves[l]->box;
+    Candidate leaf_best;
+    leaf_best.inliers = -1;
+    for (int i = 0; i < kLeafLattice * kLeafLattice * kLeafLattice; ++i)
+    {
+      const Pose2 pose(at(b.x0, b.x1, i % kLeafLattice), at(b.y0, b.y1, (i / kLeafLattice) % kLeafLattice),
+                       at(b.t0, b.t1, i / (kLeafLattice * kLeafLattice)));
+      Candidate c = verifiedCandidate(map, pose, readings, eps);
+      if (leaf_best.inliers < 0 || betterCandidate(c, leaf_best))
+      {
+        leaf_best = std::move(c);
+      }
+    }
+    lattice_best.push_back(std::move(leaf_best));
+  }
+  return lattice_best;
+}
+
+RefinementSettings latticeRefinement(const LocalizerOptions& options, double cell_xy, double cell_theta)
+{
+  RefinementSettings settings;
+  settings.agreement_tolerance = options.agreement_tolerance;
+  settings.robust_scale = std::max(options.agreement_tolerance, cell_xy);
+  settings.seed_position_error = cell_xy;
+  settings.seed_angle_error = cell_theta;
+  return settings;
 }
 
 }  // namespace core

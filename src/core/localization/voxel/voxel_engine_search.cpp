@@ -7,6 +7,7 @@
 #include "fdml_localization/core/localization/seed_search.h"
 #include "fdml_localization/core/localization/components.h"
 #include "fdml_localization/core/localization/adaptive/leaf_clustering.h"
+#include "fdml_localization/core/localization/adaptive/leaf_search.h"
 #include "fdml_localization/core/localization/adaptive/region_fill.h"
 #include "fdml_localization/core/localization/hypothesis_seeds.h"
 #include "fdml_localization/core/localization/region_starts.h"

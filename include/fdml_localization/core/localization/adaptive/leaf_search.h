@@ -15,6 +15,22 @@ namespace fdml_localization
 {
 namespace core
 {
+/// Lattice points per axis inside each leaf leafLatticeBests() verifies.
+constexpr int kLeafLattice = 3;
+
+/**
+ * @brief The best exactly verified pose (agreement band @p eps [m]) of a kLeafLattice^3 lattice
+ *        in each of @p leaves, at most @p max_leaves of them spread evenly over the list.
+ */
+std::vector<Candidate> leafLatticeBests(const MapRayCaster& map, const std::vector<const LeafBox*>& leaves,
+                                        std::size_t max_leaves, const std::vector<Reading>& readings, double eps);
+
+/**
+ * @brief The refinement of a lattice pose in a leaf (or voxel) of @p cell_xy [m] by
+ *        @p cell_theta [rad]: seeded one leaf from the optimum, at least eps wide.
+ */
+RefinementSettings latticeRefinement(const LocalizerOptions& options, double cell_xy, double cell_theta);
+
 /// A pose explaining at least the target less this many readings is promising: refined, and its
 /// leaf searched even where its region already holds a place (region_fill.h).
 constexpr int kPromisingSlack = 2;
@@ -37,6 +53,20 @@ constexpr int kPromisingSlack = 2;
 Candidate searchLeafForPlace(const MapRayCaster& map, const LeafBox& leaf, const Candidate& centre,
                              const std::vector<Reading>& readings, const LocalizerOptions& options,
                              const RefinementSettings& settings, int target, long& box_tests);
+
+/**
+ * @brief The screen of a leaf before its search: its sub-boxes @p depth halvings of every axis
+ *        down that may explain @p needed readings, by box tests alone (boxConsensusBound(),
+ *        range_tolerance). None left: no pose in @p leaf explains that many. Else @p centre
+ *        becomes the best verified centre of the deepest ones (at most 8 of them, spread) where
+ *        better than it (or unset, inliers < 0): where most readings are short no-returns, the
+ *        leaf's own centre, 40 cm from a place in its corner, explains 4 of 16 readings while a
+ *        sub-box's explains 15.
+ * @param box_tests counted down by the box tests made (at most 8 + 64 + ... per leaf)
+ * @return whether some sub-box may explain @p needed readings
+ */
+bool screenLeaf(const MapRayCaster& map, const PoseBox& leaf, const std::vector<Reading>& readings,
+                const LocalizerOptions& options, int needed, int depth, Candidate& centre, long& box_tests);
 
 }  // namespace core
 }  // namespace fdml_localization

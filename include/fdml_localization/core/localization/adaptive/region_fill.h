@@ -22,28 +22,15 @@ namespace fdml_localization
 {
 namespace core
 {
-/// Lattice points per axis inside each leaf leafLatticeBests() verifies.
-constexpr int kLeafLattice = 3;
-
-/**
- * @brief The best exactly verified pose (agreement band @p eps [m]) of a kLeafLattice^3 lattice
- *        in each of @p leaves, at most @p max_leaves of them spread evenly over the list.
- */
-std::vector<Candidate> leafLatticeBests(const MapRayCaster& map, const std::vector<const LeafBox*>& leaves,
-                                        std::size_t max_leaves, const std::vector<Reading>& readings, double eps);
-
-/**
- * @brief The refinement of a lattice pose in a leaf (or voxel) of @p cell_xy [m] by
- *        @p cell_theta [rad]: seeded one leaf from the optimum, at least eps wide.
- */
-RefinementSettings latticeRefinement(const LocalizerOptions& options, double cell_xy, double cell_theta);
-
 /**
  * @brief Adds to @p result (ranked, de-duplicated, at most max_candidates) the places its
  *        candidates miss. Open: the @p leaves reaching the best candidate's net consensus whose
  *        box holds no candidate's pose (within the uniqueness margins); a leaf whose centre lies
  *        within 3 sigma of a candidate's covariance grown by the leaf's size is on its continuum.
- *        Searched first the leaves whose bound exceeds the consensus (highest first; a place
+ *        Those whose bound exceeds the consensus are screened first (screenLeaf(), three
+ *        halvings, 100,000 box tests in all): a leaf with no sub-box reaching its bound has its
+ *        bound lowered by one, the others are ranked by their best sub-box centre. Searched
+ *        first the leaves whose bound exceeds the consensus (highest first; a place
  *        there raises it), then round robin over their connected regions (26 neighbours,
  *        @p theta_cells heading cells around the circle: every region's best leaf by its centre,
  *        then its second, ..., further leaves only while no place was found in the region or

@@ -1,0 +1,111 @@
+// The region fill's screen of a leaf (leaf_search.h): a screen that leaves no sub-box proves that
+// no pose of the leaf reaches the count, it proves so more often than the leaf's own box bound,
+// its ranking centre is a verified pose of the leaf, and its box tests are counted.
+#include "fdml_localization/core/localization/adaptive/leaf_search.h"
+#include "fdml_localization/core/localization/certificate.h"
+
+#include "localizer_test_utils.h"
+
+#include <gtest/gtest.h>
+
+namespace fdml_localization
+{
+namespace core
+{
+namespace
+{
+/// A free pose, readings in 6 random directions from a pose up to 15 cm and 4 deg from it, and a
+/// box of 0.5 to 40 cm and 0.3 to 11 deg holding the free pose (not, in general, the readings').
+struct ScreenCase
+{
+  Pose2 q;
+  std::vector<Reading> readings;
+  PoseBox box;
+};
+
+ScreenCase randomCase(const MapRayCaster& map, std::mt19937_64& rng)
+{
+  std::uniform_real_distribution<double> size(0.005, 0.4), jitter(-0.15, 0.15), heading(-kPi, kPi), frac(0.0, 1.0);
+  ScreenCase c;
+  c.q = test::randomFreePose(map, rng, 0.05);
+  std::vector<Pose2> offsets;
+  for (int i = 0; i < 6; ++i)
+  {
+    offsets.emplace_back(0.0, 0.0, heading(rng));
+  }
+  Pose2 source;
+  do
+  {
+    source = Pose2(c.q.x + jitter(rng), c.q.y + jitter(rng), c.q.theta + 0.5 * jitter(rng));
+  } while (!map.isFree(source.position()));
+  c.readings = test::exactReadings(map, source, offsets);
+  const double sx = size(rng), sy = size(rng), st = 0.5 * size(rng);
+  c.box.x0 = c.q.x - sx * frac(rng);
+  c.box.x1 = c.box.x0 + sx;
+  c.box.y0 = c.q.y - sy * frac(rng);
+  c.box.y1 = c.box.y0 + sy;
+  c.box.t0 = c.q.theta - st * frac(rng);
+  c.box.t1 = c.box.t0 + st;
+  return c;
+}
+
+TEST(ScreenLeaf, AnEmptyScreenProvesNoPoseOfTheLeafReachesTheCount)
+{
+  const auto map = test::loadMap("maps/apartment.poly");
+  LocalizerOptions options;
+  options.range_tolerance = 0.03;
+  std::mt19937_64 rng(77);
+  int screened_out = 0, box_out = 0;
+  for (int trial = 0; trial < 600; ++trial)
+  {
+    const ScreenCase c = randomCase(*map, rng);
+    const int at_q = consensusWithin(*map, c.q, c.readings, options.range_tolerance);
+    for (int needed = 4; needed <= 6; ++needed)
+    {
+      Candidate centre;
+      centre.inliers = -1;
+      long box_tests = 0;
+      if (!screenLeaf(*map, c.box, c.readings, options, needed, 3, centre, box_tests))
+      {
+        // q lies in the box: it must explain fewer.
+        ASSERT_LT(at_q, needed) << "trial " << trial << " needed " << needed;
+        ++screened_out;
+      }
+      box_out += boxConsensusBound(*map, c.readings, options.range_tolerance, c.box, needed) < needed;
+      EXPECT_LE(-box_tests, 8 + 64 + 512);
+      EXPECT_GE(-box_tests, 8);
+    }
+  }
+  // The screen proves at least what the leaf's bound proves, and more.
+  EXPECT_GT(screened_out, box_out + 50) << screened_out << " against " << box_out;
+}
+
+TEST(ScreenLeaf, ItsCentreIsAVerifiedPoseOfTheLeafNoWorseThanTheOneGiven)
+{
+  const auto map = test::loadMap("maps/apartment.poly");
+  LocalizerOptions options;
+  std::mt19937_64 rng(78);
+  int improved = 0;
+  for (int trial = 0; trial < 200; ++trial)
+  {
+    const ScreenCase c = randomCase(*map, rng);
+    const Candidate given = verifiedCandidate(*map, c.box.centre(), c.readings, options.agreement_tolerance);
+    Candidate centre = given;
+    long box_tests = 0;
+    if (!screenLeaf(*map, c.box, c.readings, options, 3, 3, centre, box_tests))
+    {
+      continue;
+    }
+    ASSERT_TRUE(c.box.contains(centre.pose, 1e-9, 1e-9)) << "trial " << trial;
+    const Candidate again = verifiedCandidate(*map, centre.pose, c.readings, options.agreement_tolerance);
+    EXPECT_EQ(again.inliers, centre.inliers);
+    EXPECT_EQ(again.contradicted, centre.contradicted);
+    EXPECT_FALSE(betterCandidate(given, centre)) << "trial " << trial;
+    improved += betterCandidate(centre, given);
+  }
+  EXPECT_GT(improved, 20);
+}
+
+}  // namespace
+}  // namespace core
+}  // namespace fdml_localization

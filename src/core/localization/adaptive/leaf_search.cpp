@@ -31,19 +31,31 @@ struct SubBox
   Candidate centre;
 };
 
-/// The 8 halves of @p box (every axis halved) that may still explain @p target readings, each
-/// with its centre verified; @p budget counts the box tests down.
-void keptHalves(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
-                const PoseBox& box, int target, long& budget, std::vector<SubBox>& kept)
+/// Appends to @p kept the halves of @p box (every axis halved, 8) that may still explain
+/// @p needed readings (boxConsensusBound()); @p budget counts the box tests down.
+void halvesReaching(const MapRayCaster& map, const std::vector<Reading>& readings, double range_tolerance,
+                    const PoseBox& box, int needed, long& budget, std::vector<PoseBox>& kept)
 {
   for (int c = 0; c < 8; ++c)
   {
     const PoseBox half = box.half(c);
     --budget;
-    if (boxConsensusBound(map, readings, options.range_tolerance, half, target) >= target)
+    if (boxConsensusBound(map, readings, range_tolerance, half, needed) >= needed)
     {
-      kept.push_back(SubBox{ half, verifiedCandidate(map, half.centre(), readings, options.agreement_tolerance) });
+      kept.push_back(half);
     }
+  }
+}
+
+/// halvesReaching() @p target, each half with its centre verified.
+void keptHalves(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
+                const PoseBox& box, int target, long& budget, std::vector<SubBox>& kept)
+{
+  std::vector<PoseBox> halves;
+  halvesReaching(map, readings, options.range_tolerance, box, target, budget, halves);
+  for (const PoseBox& half : halves)
+  {
+    kept.push_back(SubBox{ half, verifiedCandidate(map, half.centre(), readings, options.agreement_tolerance) });
   }
 }
 
@@ -120,14 +132,7 @@ bool screenLeaf(const MapRayCaster& map, const PoseBox& leaf, const std::vector<
     std::vector<PoseBox> next;
     for (const PoseBox& box : level)
     {
-      for (int c = 0; c < 8; ++c)
-      {
-        --box_tests;
-        if (boxConsensusBound(map, readings, options.range_tolerance, box.half(c), needed) >= needed)
-        {
-          next.push_back(box.half(c));
-        }
-      }
+      halvesReaching(map, readings, options.range_tolerance, box, needed, box_tests, next);
     }
     level = std::move(next);
   }

@@ -1,6 +1,7 @@
 // widenAlongContinua(): a candidate's covariance widened along the directions in which its
 // pose can move while its readings keep agreeing (a corridor, parallel walls, a cone facing a
-// flat wall), where the polish's local derivative cannot see it.
+// flat wall), where the polish's local derivative cannot see it; settleAlongContinua(): first
+// the exact place at such a continuum's end, where the polish has no gradient to reach it.
 #include "fdml_localization/core/localization/robust_search.h"
 
 #include <algorithm>
@@ -46,28 +47,38 @@ bool stillAgrees(const MapRayCaster& map, const std::vector<Reading>& readings, 
   return true;
 }
 
-/// How far [m or rad] the pose can move along @p direction (one way) while it still agrees.
-double extent(const MapRayCaster& map, const std::vector<Reading>& readings, const Candidate& candidate,
-              const std::vector<double>& residuals, const Eigen::Vector3d& direction, double noise, double limit)
+/// Where the pose stops agreeing along a direction (one way) [m or rad]: it still agrees at
+/// @c ok and no longer at @c beyond (+inf: it agrees up to the probe's limit).
+struct ContinuumEnd
 {
   double ok = 0.0;
+  double beyond = kInf;
+};
+
+/// How far the pose can move along @p direction (one way) while it still agrees.
+ContinuumEnd extent(const MapRayCaster& map, const std::vector<Reading>& readings, const Candidate& candidate,
+                    const std::vector<double>& residuals, const Eigen::Vector3d& direction, double noise, double limit)
+{
+  ContinuumEnd end;
   double trial = 1e-3;
   while (trial <= limit &&
          stillAgrees(map, readings, candidate, residuals, moved(candidate.pose, direction, trial), noise))
   {
-    ok = trial;
+    end.ok = trial;
     trial *= 2.0;
   }
   if (trial > limit)
   {
-    return ok;
+    return end;
   }
+  end.beyond = trial;
   for (int i = 0; i < 4; ++i)
   {
-    const double mid = 0.5 * (ok + trial);
-    (stillAgrees(map, readings, candidate, residuals, moved(candidate.pose, direction, mid), noise) ? ok : trial) = mid;
+    const double mid = 0.5 * (end.ok + end.beyond);
+    (stillAgrees(map, readings, candidate, residuals, moved(candidate.pose, direction, mid), noise) ? end.ok :
+                                                                                                      end.beyond) = mid;
   }
-  return ok;
+  return end;
 }
 
 /// The probed directions: x, y, the heading, and the direction of each wall an inlier ray hits.
@@ -100,24 +111,178 @@ std::vector<Eigen::Vector3d> probeDirections(const MapRayCaster& map, const std:
   }
   return directions;
 }
+
+/// A direction the pose was probed along, with both its ends.
+struct Continuum
+{
+  Eigen::Vector3d u;
+  ContinuumEnd ahead, behind;  ///< along u and along -u
+
+  double reach() const
+  {
+    return std::max(ahead.ok, behind.ok);
+  }
+};
+
+/// The probed directions with their ends (probeDirections(), extent()).
+std::vector<Continuum> continua(const MapRayCaster& map, const std::vector<Reading>& readings,
+                                const Candidate& candidate, double noise)
+{
+  const std::vector<double> residuals = evaluatePose(map, candidate.pose, readings, kInf).residuals;
+  std::vector<Continuum> found;
+  for (const Eigen::Vector3d& u : probeDirections(map, readings, candidate))
+  {
+    const double limit = u(2) != 0.0 ? kMaxTurn : kMaxShift;
+    found.push_back(Continuum{ u, extent(map, readings, candidate, residuals, u, noise, limit),
+                               extent(map, readings, candidate, residuals, -u, noise, limit) });
+  }
+  return found;
+}
+
+/// True when the pose's reach along @p c exceeds 3 standard deviations of @p covariance.
+bool isContinuum(const Continuum& c, const Eigen::Matrix3d& covariance)
+{
+  return c.reach() * c.reach() > 9.0 * c.u.dot(covariance * c.u);
+}
+
+/// widenAlongContinua() with the probed @p found.
+void widenWith(const std::vector<Continuum>& found, Candidate& candidate)
+{
+  for (const Continuum& c : found)
+  {
+    const double variance = c.u.dot(candidate.covariance * c.u);
+    // A uniform spread over [-reach, reach]; only where it exceeds 3 standard deviations.
+    if (isContinuum(c, candidate.covariance))
+    {
+      candidate.covariance += (c.reach() * c.reach() / 3.0 - variance) * c.u * c.u.transpose();
+    }
+  }
+}
+
+/// Bisections of a residual's sign change: a 4 m probe down to 0.25 um.
+constexpr int kRootBisections = 24;
+
+/**
+ * The poses between @p pose and @p beyond along @p direction where a finite inlier of
+ * @p candidate explains its reading exactly: for each one whose residual changes sign on the way,
+ * the crossing (bisected), on the side of the smaller residual.
+ */
+std::vector<Pose2> residualRoots(const MapRayCaster& map, const std::vector<Reading>& readings,
+                                 const Candidate& candidate, const Eigen::Vector3d& direction, double beyond)
+{
+  std::vector<Pose2> roots;
+  const Pose2 far = moved(candidate.pose, direction, beyond);
+  for (std::size_t i = 0; i < readings.size(); ++i)
+  {
+    const double r0 = readingResidual(map, candidate.pose, readings[i]);
+    const double r1 = readingResidual(map, far, readings[i]);
+    if (!candidate.inlier_mask[i] || !std::isfinite(readings[i].range) || !std::isfinite(r0) || !std::isfinite(r1) ||
+        (r0 < 0.0) == (r1 < 0.0))
+    {
+      continue;
+    }
+    double lo = 0.0, hi = beyond, r_lo = r0, r_hi = r1;
+    for (int b = 0; b < kRootBisections; ++b)
+    {
+      const double mid = 0.5 * (lo + hi);
+      const double r = readingResidual(map, moved(candidate.pose, direction, mid), readings[i]);
+      if (!std::isfinite(r))
+      {
+        break;
+      }
+      ((r < 0.0) == (r0 < 0.0) ? lo : hi) = mid;
+      ((r < 0.0) == (r0 < 0.0) ? r_lo : r_hi) = r;
+    }
+    roots.push_back(moved(candidate.pose, direction, std::abs(r_lo) <= std::abs(r_hi) ? lo : hi));
+  }
+  return roots;
+}
+
+/// An RMS below this is exact: the rounding of a polish [m].
+constexpr double kExactRms = 1e-6;
+
+/// A direction is a continuum where the candidate's standard deviation along it exceeds this
+/// many times the noise ([m], or [rad] per metre of it for the heading).
+constexpr double kContinuumSpread = 3.0;
+
+/// A candidate's RMS must at least halve for a pose at a continuum's end to replace it: along a
+/// corridor with range noise, one reading's root moves the RMS by a fraction of the noise.
+constexpr double kEndGain = 0.5;
+
+/// The pose polished from @p start on @p candidate's finite inliers, as a candidate.
+Candidate polishedFrom(const MapRayCaster& map, const std::vector<Reading>& readings,
+                       const RefinementSettings& settings, const Candidate& candidate, const Pose2& start)
+{
+  std::vector<bool> use = candidate.inlier_mask;
+  for (std::size_t i = 0; i < readings.size(); ++i)
+  {
+    use[i] = use[i] && std::isfinite(readings[i].range);
+  }
+  const PolishOutcome polished = polishPose(map, start, readings, use, settings.agreement_tolerance,
+                                            settings.max_iterations, settings.noise_sigma);
+  Candidate c = candidateFrom(polished.pose, evaluatePose(map, polished.pose, readings, settings.agreement_tolerance));
+  c.covariance = polished.covariance;
+  c.support = candidate.support;
+  return c;
+}
 }  // namespace
 
 void widenAlongContinua(const MapRayCaster& map, const std::vector<Reading>& readings, double noise,
                         Candidate& candidate)
 {
-  const std::vector<double> residuals = evaluatePose(map, candidate.pose, readings, kInf).residuals;
-  for (const Eigen::Vector3d& u : probeDirections(map, readings, candidate))
+  widenWith(continua(map, readings, candidate, noise), candidate);
+}
+
+void settleAlongContinua(const MapRayCaster& map, const std::vector<Reading>& readings,
+                         const RefinementSettings& settings, Candidate& candidate)
+{
+  const std::vector<Continuum> found = continua(map, readings, candidate, settings.noise_sigma);
+  Candidate widened = candidate;
+  widenWith(found, widened);
+  Candidate best = candidate;
+  bool moved_on = false;
+  for (const Continuum& c : found)
   {
-    const double limit = u(2) != 0.0 ? kMaxTurn : kMaxShift;
-    const double reach = std::max(extent(map, readings, candidate, residuals, u, noise, limit),
-                                  extent(map, readings, candidate, residuals, -u, noise, limit));
-    const double variance = u.dot(candidate.covariance * u);
-    // A uniform spread over [-reach, reach]; only where it exceeds 3 standard deviations.
-    if (reach * reach > 9.0 * variance)
+    // Along a continuum the pose is uncertain by far more than the noise (its covariance already
+    // says so where the readings leave the direction undetermined, or once widened).
+    const double spread = kContinuumSpread * settings.noise_sigma;
+    if (candidate.rms_residual < kExactRms || c.u.dot(widened.covariance * c.u) <= spread * spread)
     {
-      candidate.covariance += (reach * reach / 3.0 - variance) * u * u.transpose();
+      continue;
+    }
+    for (const auto& [u, end] : { std::make_pair(c.u, c.ahead), std::make_pair(Eigen::Vector3d(-c.u), c.behind) })
+    {
+      for (const Pose2& root :
+           std::isfinite(end.beyond) ? residualRoots(map, readings, candidate, u, end.beyond) : std::vector<Pose2>{})
+      {
+        Candidate polished = polishedFrom(map, readings, settings, candidate, root);
+        const bool gain = netConsensus(polished) > netConsensus(candidate) ||
+                          polished.rms_residual < kEndGain * candidate.rms_residual;
+        if (gain && betterCandidate(polished, best))
+        {
+          best = std::move(polished);
+          moved_on = true;
+        }
+      }
     }
   }
+  if (!moved_on)
+  {
+    candidate = std::move(widened);
+    return;
+  }
+  // Within the noise of the candidate, the continuum it lay on stays plausible (one reading 2 cm
+  // off is twice a 1 cm noise): the settled pose's covariance covers it too, never a confident
+  // pose 50 cm along a corridor from where noisy readings put the truth.
+  const bool tie = netConsensus(best) == netConsensus(candidate) &&
+                   candidate.rms_residual <= best.rms_residual + settings.noise_sigma;
+  widenAlongContinua(map, readings, settings.noise_sigma, best);
+  if (tie)
+  {
+    const Eigen::Vector3d d = poseDifference(candidate.pose, best.pose);
+    best.covariance += widened.covariance + d * d.transpose();
+  }
+  candidate = std::move(best);
 }
 
 }  // namespace core

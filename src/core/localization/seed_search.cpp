@@ -225,7 +225,7 @@ private:
       ensureCovariance(ctx_.map, ctx_.readings, ctx_.settings.noise_sigma, kept[j]);
       if (netConsensus(kept[j]) < top)
       {
-        widenAlongContinua(ctx_.map, ctx_.readings, ctx_.settings.noise_sigma, kept[j]);
+        settleAlongContinua(ctx_.map, ctx_.readings, ctx_.settings, kept[j]);
         continue;
       }
       const SearchSeed& seed = seeds_[static_cast<std::size_t>(kept[j].support)];
@@ -236,7 +236,7 @@ private:
         polished.support = kept[j].support;
         kept[j] = std::move(polished);
       }
-      widenAlongContinua(ctx_.map, ctx_.readings, ctx_.settings.noise_sigma, kept[j]);
+      settleAlongContinua(ctx_.map, ctx_.readings, ctx_.settings, kept[j]);
       // A tie within the uniqueness margins of kept[j] is its duplicate, but first widens its
       // covariance to cover it (absorbTiedDuplicates()): de-duplicated among themselves first,
       // the ties could lose the one that is the truth.
@@ -249,7 +249,7 @@ private:
       for (Candidate& tie : ties[j])
       {
         tie.support = kept[j].support;
-        widenAlongContinua(ctx_.map, ctx_.readings, ctx_.settings.noise_sigma, tie);
+        settleAlongContinua(ctx_.map, ctx_.readings, ctx_.settings, tie);
       }
     }
     for (std::vector<Candidate>& found : ties)

@@ -282,7 +282,7 @@ void AdaptiveEngine::searchNoReturnRegion(const AdaptiveSearch& search, const st
   if (found_net > best_net)
   {
     ensureCovariance(*map_, readings, settings.noise_sigma, found);
-    widenAlongContinua(*map_, readings, settings.noise_sigma, found);
+    settleAlongContinua(*map_, readings, settings, found);
     // An automatic k' is the largest consensus found.
     result.min_inliers_used = options_.min_inliers > 0 ? result.min_inliers_used : found_net;
     result.candidates.insert(result.candidates.begin(), std::move(found));

@@ -239,16 +239,15 @@ struct FillState
   long budget;                   ///< box tests left
 };
 
-/// Adds a @p place found in @p leaf to the known candidates, unless one lies within kNearLeaves
-/// leaves of it (at least the uniqueness margins): a place no better than that one is its
-/// near-duplicate (a tie widens that one's covariance to cover it, absorbTiedDuplicates()), a
-/// better one replaces it. A near-duplicate 3 to 5 cm and 6 deg off, listed as a place of its
-/// own, was published by the office tracking launch as the pose for half a second.
-void admit(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options, double noise,
-           const PoseBox& leaf, Candidate place, FillState& state)
+/// Adds a @p place found in @p leaf (settled, settleAlongContinua()) to the known candidates, unless one lies within
+/// kNearLeaves leaves of it (at least the uniqueness margins): a place no better than that one is its near-duplicate (a
+/// tie widens that one's covariance to cover it, absorbTiedDuplicates()), a better one replaces it. A near-duplicate 3
+/// to 5 cm and 6 deg off, listed as a place of its own, was published by the office tracking launch as the pose for
+/// half a second.
+void admit(const LocalizerOptions& options, const RefinementSettings& settings, const PoseBox& leaf, Candidate place,
+           FillState& state)
 {
   place.support = 1.0;
-  widenAlongContinua(map, readings, noise, place);
   state.found.add(place);
   state.changed = true;
   const double near_xy = std::max(options.uniqueness_distance, kNearLeaves * (leaf.x1 - leaf.x0));
@@ -267,7 +266,7 @@ void admit(const MapRayCaster& map, const std::vector<Reading>& readings, const 
     else
     {
       std::vector<Candidate> kept{ known };
-      absorbTiedDuplicates({ place }, near_xy, near_theta, noise, kept);
+      absorbTiedDuplicates({ place }, near_xy, near_theta, settings.noise_sigma, kept);
       known.covariance = kept.front().covariance;
     }
     return;
@@ -348,13 +347,20 @@ void fillPass(const MapRayCaster& map, const std::vector<Reading>& readings, con
     {
       o.centre = verifiedCandidate(map, o.leaf->box.centre(), readings, options.agreement_tolerance);
     }
-    const Candidate place =
+    Candidate place =
         placeInLeaf(map, readings, options, settings, o, beyond ? state.target + 1 : state.target, state.budget);
-    if (netConsensus(place) >= state.target && (rival.inliers < 0 || betterCandidate(place, rival)))
+    if (netConsensus(place) < state.target)
+    {
+      continue;
+    }
+    // Settled before it meets its rival: on a corridor's continuum a place 5 cm from an exact
+    // one ties the rival's RMS of 7 mm, and unsettled it was dropped as no better.
+    settleAlongContinua(map, readings, settings, place);
+    if (rival.inliers < 0 || betterCandidate(place, rival))
     {
       state.target = netConsensus(place);
       state.placed[static_cast<std::size_t>(o.region)] = 1;
-      admit(map, readings, options, settings.noise_sigma, o.leaf->box, std::move(place), state);
+      admit(options, settings, o.leaf->box, std::move(place), state);
     }
   }
 }

@@ -40,11 +40,16 @@ constexpr int kPromisingSlack = 2;
  *        (every axis halved, four times: a 75 cm, 5.6 deg leaf down to 4.7 cm and 0.35 deg; six
  *        times, down to 1.2 cm and 0.09 deg, while the best centre explains within two readings
  *        of the target), only those that may still explain @p target readings
- *        (boxConsensusBound(), range_tolerance), at most 16 per level (the best verified
- *        centres). The best centre so far is refined (refineSeed() with @p settings, its scales
- *        set to the centre's sub-box) once it explains within two readings of the target, or
- *        from the fourth level on, and kept when the refinement stays within two leaves of it;
- *        the search stops at a pose reaching the target. Where rays graze corners or short
+ *        (boxConsensusBound(), range_tolerance), at most 16 per level: those whose centres
+ *        explain the most readings within the band a pose of the box allows (eps, half the box's
+ *        diagonal and half its heading span times the reading's reach), then with the least
+ *        residuals relative to it. The best verified centre so far is refined (refineSeed() with
+ *        @p settings, its scales set to the centre's sub-box, on the centre's inliers and every
+ *        reading the sub-box's box test keeps) once it explains within two readings of the
+ *        target, or from the fourth level on; where none is that close, at the fourth level the
+ *        first sub-box of the beam is refined too (with readings of 11 m, the centre of the
+ *        truth's 4.7 cm, 0.35 deg sub-box explains 2 of 5 within eps). A refinement is kept when
+ *        it stays within two leaves of its start; the search stops at a pose reaching the target. Where rays graze corners or short
  *        no-return ranges shape it, a place can be a few centimetres or millimetres wide: a
  *        lattice of the whole leaf misses it.
  * @param centre the leaf's centre, verified (the answer when nothing better is found)

@@ -239,11 +239,10 @@ struct FillState
   long budget;                   ///< box tests left
 };
 
-/// Adds a @p place found in @p leaf (settled, settleAlongContinua()) to the known candidates, unless one lies within
-/// kNearLeaves leaves of it (at least the uniqueness margins): a place no better than that one is its near-duplicate (a
-/// tie widens that one's covariance to cover it, absorbTiedDuplicates()), a better one replaces it. A near-duplicate 3
-/// to 5 cm and 6 deg off, listed as a place of its own, was published by the office tracking launch as the pose for
-/// half a second.
+/// Adds a @p place found in @p leaf to the known candidates, unless one lies within kNearLeaves leaves of it (at least
+/// the uniqueness margins): a place no better than that one is its near-duplicate (a tie widens that one's covariance
+/// to cover it, absorbTiedDuplicates()), a better one replaces it. The office tracking launch once published such a
+/// near-duplicate (3 to 5 cm and 6 deg off) as the pose for half a second.
 void admit(const LocalizerOptions& options, const RefinementSettings& settings, const PoseBox& leaf, Candidate place,
            FillState& state)
 {
@@ -274,10 +273,11 @@ void admit(const LocalizerOptions& options, const RefinementSettings& settings, 
   state.known.push_back(std::move(place));
 }
 
-/// searchLeafForPlace() in @p o's leaf for @p goal readings, then, while the place found
-/// explains fewer than the leaf's bound, again for one more: the first place reaching the goal
-/// need not be the leaf's best (in a corridor, 29 of 30 readings with one contradicted, 6 mm from
-/// the truth's 30 on the same continuum).
+/// searchLeafForPlace() in @p o's leaf for @p goal readings, then, while the place found explains fewer than the
+/// leaf's bound, again for one more: the first place reaching the goal need not be the leaf's best (in a corridor, 29
+/// of 30 readings with one contradicted, 6 mm from the truth's 30 on the same continuum). The fill settles a place
+/// reaching its target (settleAlongContinua()) before it meets its rival: on a corridor's continuum, a place 5 cm
+/// from an exact one ties the rival's RMS of 7 mm, and unsettled it was dropped as no better.
 Candidate placeInLeaf(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
                       const RefinementSettings& settings, const OpenLeaf& o, int goal, long& budget)
 {
@@ -315,9 +315,8 @@ bool leftToFound(Accounting& found, const PoseBox& box, int pass, Candidate& riv
   return false;
 }
 
-/// One pass over the open leaves in @p order. Pass 0 leaves for pass 1 (while the budget lasts)
-/// the leaves of regions holding a place and those on a candidate's continuum: mostly they hold
-/// those places again.
+/// One pass over the open leaves in @p order. Pass 0 leaves for pass 1 (while the budget lasts) the leaves of
+/// regions holding a place and those on a candidate's continuum: mostly they hold those places again.
 void fillPass(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
               const RefinementSettings& settings, std::vector<OpenLeaf>& open, const std::vector<std::size_t>& order,
               int pass, FillState& state)
@@ -349,14 +348,11 @@ void fillPass(const MapRayCaster& map, const std::vector<Reading>& readings, con
     }
     Candidate place =
         placeInLeaf(map, readings, options, settings, o, beyond ? state.target + 1 : state.target, state.budget);
-    if (netConsensus(place) < state.target)
+    if (netConsensus(place) >= state.target)
     {
-      continue;
+      settleAlongContinua(map, readings, settings, place);  // before it meets its rival (placeInLeaf())
     }
-    // Settled before it meets its rival: on a corridor's continuum a place 5 cm from an exact
-    // one ties the rival's RMS of 7 mm, and unsettled it was dropped as no better.
-    settleAlongContinua(map, readings, settings, place);
-    if (rival.inliers < 0 || betterCandidate(place, rival))
+    if (netConsensus(place) >= state.target && (rival.inliers < 0 || betterCandidate(place, rival)))
     {
       state.target = netConsensus(place);
       state.placed[static_cast<std::size_t>(o.region)] = 1;

@@ -163,9 +163,9 @@ void widenWith(const std::vector<Continuum>& found, Candidate& candidate)
 constexpr int kRootBisections = 24;
 
 /**
- * The poses between @p pose and @p beyond along @p direction where a finite inlier of
- * @p candidate explains its reading exactly: for each one whose residual changes sign on the way,
- * the crossing (bisected), on the side of the smaller residual.
+ * The poses between @p candidate's and the one @p beyond along @p direction where a finite inlier
+ * of @p candidate explains its reading exactly: for each one whose residual changes sign on the
+ * way, the crossing (bisected), on the side of the smaller residual.
  */
 std::vector<Pose2> residualRoots(const MapRayCaster& map, const std::vector<Reading>& readings,
                                  const Candidate& candidate, const Eigen::Vector3d& direction, double beyond)
@@ -174,10 +174,13 @@ std::vector<Pose2> residualRoots(const MapRayCaster& map, const std::vector<Read
   const Pose2 far = moved(candidate.pose, direction, beyond);
   for (std::size_t i = 0; i < readings.size(); ++i)
   {
+    if (!candidate.inlier_mask[i] || !std::isfinite(readings[i].range))
+    {
+      continue;
+    }
     const double r0 = readingResidual(map, candidate.pose, readings[i]);
     const double r1 = readingResidual(map, far, readings[i]);
-    if (!candidate.inlier_mask[i] || !std::isfinite(readings[i].range) || !std::isfinite(r0) || !std::isfinite(r1) ||
-        (r0 < 0.0) == (r1 < 0.0))
+    if (!std::isfinite(r0) || !std::isfinite(r1) || (r0 < 0.0) == (r1 < 0.0))
     {
       continue;
     }

@@ -185,14 +185,18 @@ Candidate refineSeed(const MapRayCaster& map, const Pose2& seed, const std::vect
  *        continuum it lies on. Along a corridor, a ray passing a corner can be 2 cm short for
  *        every pose behind the exact place and grow 3 cm per cm beyond it: the exact place is a
  *        few millimetres wide and the polish, with no gradient along the corridor, stops anywhere
- *        on it. At each end of each direction widenAlongContinua() probes (where the reach
- *        exceeds 3 standard deviations), a finite inlier whose residual changes sign between
+ *        on it. At each end of each direction widenAlongContinua() probes where the candidate's
+ *        standard deviation (widened) exceeds 3 noise_sigma ([rad] per metre for the heading),
+ *        a finite inlier whose residual changes sign between
  *        the candidate and the first pose beyond the end is explained exactly in between: the
  *        crossing (bisected to 0.25 um per 4 m) is polished on the candidate's finite inliers
  *        (settings' eps as the robust scale, noise_sigma, max_iterations). The best such pose
  *        replaces the candidate when it ranks before it (betterCandidate()) by more net readings
- *        or by at most half its RMS, so that range noise alone never moves a pose along a
- *        corridor. An exact candidate (RMS below 1e-6 m) is never moved.
+ *        or at most half its RMS. Where the candidate ties it within the noise (the same net
+ *        consensus, an RMS within noise_sigma of it), the continuum it lay on stays plausible: the
+ *        settled pose's covariance adds the candidate's widened one and the move's outer product,
+ *        so that noisy readings never turn an honest spread along a corridor into a confident
+ *        pose 50 cm from the truth. An exact candidate (RMS below 1e-6 m) is never moved.
  */
 void settleAlongContinua(const MapRayCaster& map, const std::vector<Reading>& readings,
                          const RefinementSettings& settings, Candidate& candidate);

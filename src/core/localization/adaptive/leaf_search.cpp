@@ -163,8 +163,11 @@ Candidate searchLeafForPlace(const MapRayCaster& map, const LeafBox& leaf, const
         break;
       }
     }
-    // Where no centre is promising, the box closest at its own scale too (long ranges).
-    if (!promising && depth == kFillDepth && top != next.begin() && refine(next.front().box, next.front().centre))
+    // Where no centre is promising, the box closest at its own scale too (long ranges), when
+    // promising at that scale.
+    const bool close = !next.empty() && next.front().within >= target - kPromisingSlack;
+    if (!promising && close && depth == kFillDepth && top != next.begin() &&
+        refine(next.front().box, next.front().centre))
     {
       break;
     }

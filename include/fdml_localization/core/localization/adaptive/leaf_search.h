@@ -47,11 +47,12 @@ constexpr int kPromisingSlack = 2;
  *        @p settings, its scales set to the centre's sub-box, on the centre's inliers and every
  *        reading the sub-box's box test keeps) once it explains within two readings of the
  *        target, or from the fourth level on; where none is that close, at the fourth level the
- *        first sub-box of the beam is refined too (with readings of 11 m, the centre of the
- *        truth's 4.7 cm, 0.35 deg sub-box explains 2 of 5 within eps). A refinement is kept when
- *        it stays within two leaves of its start; the search stops at a pose reaching the target. Where rays graze corners or short
- *        no-return ranges shape it, a place can be a few centimetres or millimetres wide: a
- *        lattice of the whole leaf misses it.
+ *        first sub-box of the beam is refined too when its centre explains within two readings
+ *        of the target within the bands (with readings of 11 m, the centre of the truth's 4.7 cm,
+ *        0.35 deg sub-box explains 2 of 5 within eps and 3 within the bands). A refinement is kept when
+ *        it stays within two leaves of its start; the search stops at a pose reaching the target. Where rays graze
+ * corners or short no-return ranges shape it, a place can be a few centimetres or millimetres wide: a lattice of the
+ * whole leaf misses it.
  * @param centre the leaf's centre, verified (the answer when nothing better is found)
  * @param box_tests counted down by the box tests made (the search of a leaf is never cut)
  */

@@ -143,7 +143,7 @@ bool HypothesisTracker::updateOne(Hypothesis& h, const std::vector<Reading>& rea
     h.support = options_.support_decay * h.support + std::max(0, found.best_consensus) / k;
     return false;
   }
-  const std::size_t chosen = chooseFix(found.fixes, predicted, h.covariance + leastCovariance());
+  const std::size_t chosen = chooseFix(found.fixes, predicted);
   const Candidate& fix = found.fixes[chosen];
   const FusedPose fused = fusePose(predicted, h.covariance, fix.pose, fixNoise(h, predicted, found, chosen));
   h.map_to_odom = compose(fused.pose, inverse(reference));
@@ -208,20 +208,19 @@ bool HypothesisTracker::withinMargins(const Eigen::Matrix3d& covariance) const
          headingSigma3(covariance) <= options_.publish_max_theta;
 }
 
-std::size_t HypothesisTracker::chooseFix(const std::vector<Candidate>& fixes, const Pose2& predicted,
-                                         const Eigen::Matrix3d& covariance) const
+std::size_t HypothesisTracker::chooseFix(const std::vector<Candidate>& fixes, const Pose2& predicted) const
 {
   // Among the fixes tied with the best on net consensus, the one nearest the prediction (the box
-  // is the hypothesis's uncertainty: new places come from global solves only), in heading too:
-  // by position alone, a fix 6 deg off but a centimetre nearer won.
+  // is the hypothesis's uncertainty: new places come from global solves only).
   const int best = netConsensus(fixes.front());
-  const auto distance = [&](const Candidate& c) {
-    return squaredMahalanobis(c.pose, predicted, covariance + c.covariance);
-  };
   std::size_t chosen = 0;
   for (std::size_t i = 1; i < fixes.size() && netConsensus(fixes[i]) == best; ++i)
   {
-    chosen = distance(fixes[i]) < distance(fixes[chosen]) ? i : chosen;
+    if ((fixes[i].pose.position() - predicted.position()).norm() <
+        (fixes[chosen].pose.position() - predicted.position()).norm())
+    {
+      chosen = i;
+    }
   }
   return chosen;
 }

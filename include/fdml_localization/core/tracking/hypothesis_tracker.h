@@ -263,11 +263,8 @@ private:
   Eigen::Matrix3d initialCovariance(const Candidate& candidate) const;
   /// The covariance of the smallest search box (box_min_xy, box_min_theta as 3 sigma).
   Eigen::Matrix3d leastCovariance() const;
-  /// The index of the fix (of at least one) that carries a hypothesis predicted at @p predicted
-  /// with @p covariance [m^2, rad^2]: of those tied on net consensus, the nearest by Mahalanobis
-  /// distance (the fix's own covariance added).
-  std::size_t chooseFix(const std::vector<Candidate>& fixes, const Pose2& predicted,
-                        const Eigen::Matrix3d& covariance) const;
+  /// The index of the fix (of at least one) that carries a hypothesis predicted at @p predicted.
+  std::size_t chooseFix(const std::vector<Candidate>& fixes, const Pose2& predicted) const;
   /// The covariance with which fix @p i of @p found is fused into @p h, predicted at
   /// @p predicted [m^2, rad^2].
   Eigen::Matrix3d fixNoise(const Hypothesis& h, const Pose2& predicted, const LocalSolveOutcome& found,

@@ -124,11 +124,18 @@ struct Continuum
   }
 };
 
-/// The probed directions with their ends (probeDirections(), extent()).
-std::vector<Continuum> continua(const MapRayCaster& map, const std::vector<Reading>& readings,
-                                const Candidate& candidate, double noise)
+/// The residuals of @p candidate's readings at its pose (NaN for no-returns) [m].
+std::vector<double> residualsAt(const MapRayCaster& map, const std::vector<Reading>& readings,
+                                const Candidate& candidate)
 {
-  const std::vector<double> residuals = evaluatePose(map, candidate.pose, readings, kInf).residuals;
+  return evaluatePose(map, candidate.pose, readings, kInf).residuals;
+}
+
+/// The probed directions with their ends (probeDirections(), extent()), from @p candidate's
+/// @p residuals (residualsAt()).
+std::vector<Continuum> continua(const MapRayCaster& map, const std::vector<Reading>& readings,
+                                const Candidate& candidate, const std::vector<double>& residuals, double noise)
+{
   std::vector<Continuum> found;
   for (const Eigen::Vector3d& u : probeDirections(map, readings, candidate))
   {
@@ -165,10 +172,12 @@ constexpr int kRootBisections = 24;
 /**
  * The poses between @p candidate's and the one @p beyond along @p direction where a finite inlier
  * of @p candidate explains its reading exactly: for each one whose residual changes sign on the
- * way, the crossing (bisected), on the side of the smaller residual.
+ * way (from its value in @p residuals, residualsAt()), the crossing (bisected), on the side of the
+ * smaller residual.
  */
 std::vector<Pose2> residualRoots(const MapRayCaster& map, const std::vector<Reading>& readings,
-                                 const Candidate& candidate, const Eigen::Vector3d& direction, double beyond)
+                                 const Candidate& candidate, const std::vector<double>& residuals,
+                                 const Eigen::Vector3d& direction, double beyond)
 {
   std::vector<Pose2> roots;
   const Pose2 far = moved(candidate.pose, direction, beyond);
@@ -178,7 +187,7 @@ std::vector<Pose2> residualRoots(const MapRayCaster& map, const std::vector<Read
     {
       continue;
     }
-    const double r0 = readingResidual(map, candidate.pose, readings[i]);
+    const double r0 = residuals[i];
     const double r1 = readingResidual(map, far, readings[i]);
     if (!std::isfinite(r0) || !std::isfinite(r1) || (r0 < 0.0) == (r1 < 0.0))
     {
@@ -233,13 +242,14 @@ Candidate polishedFrom(const MapRayCaster& map, const std::vector<Reading>& read
 void widenAlongContinua(const MapRayCaster& map, const std::vector<Reading>& readings, double noise,
                         Candidate& candidate)
 {
-  widenWith(continua(map, readings, candidate, noise), candidate);
+  widenWith(continua(map, readings, candidate, residualsAt(map, readings, candidate), noise), candidate);
 }
 
 void settleAlongContinua(const MapRayCaster& map, const std::vector<Reading>& readings,
                          const RefinementSettings& settings, Candidate& candidate)
 {
-  const std::vector<Continuum> found = continua(map, readings, candidate, settings.noise_sigma);
+  const std::vector<double> residuals = residualsAt(map, readings, candidate);
+  const std::vector<Continuum> found = continua(map, readings, candidate, residuals, settings.noise_sigma);
   Candidate widened = candidate;
   widenWith(found, widened);
   Candidate best = candidate;
@@ -255,8 +265,9 @@ void settleAlongContinua(const MapRayCaster& map, const std::vector<Reading>& re
     }
     for (const auto& [u, end] : { std::make_pair(c.u, c.ahead), std::make_pair(Eigen::Vector3d(-c.u), c.behind) })
     {
-      for (const Pose2& root :
-           std::isfinite(end.beyond) ? residualRoots(map, readings, candidate, u, end.beyond) : std::vector<Pose2>{})
+      for (const Pose2& root : std::isfinite(end.beyond) ?
+                                   residualRoots(map, readings, candidate, residuals, u, end.beyond) :
+                                   std::vector<Pose2>{})
       {
         Candidate polished = polishedFrom(map, readings, settings, candidate, root);
         const bool gain = netConsensus(polished) > netConsensus(candidate) ||

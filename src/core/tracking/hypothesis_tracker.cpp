@@ -2,6 +2,9 @@
 
 #include "fdml_localization/core/localization/ranking.h"
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
 #include <iterator>
@@ -14,6 +17,22 @@ namespace core
 {
 namespace
 {
+/// @p m reduced to at most @p bound in every direction: its eigenvalues relative to @p bound
+/// (whitened by bound's Cholesky factor) clamped to 1. @p m when @p bound is not positive definite.
+Eigen::Matrix3d cappedBy(const Eigen::Matrix3d& m, const Eigen::Matrix3d& bound)
+{
+  const Eigen::LLT<Eigen::Matrix3d> llt(bound);
+  if (llt.info() != Eigen::Success)
+  {
+    return m;
+  }
+  const Eigen::Matrix3d l = llt.matrixL();
+  const Eigen::Matrix3d l_inv = l.inverse();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(l_inv * m * l_inv.transpose());
+  const Eigen::Vector3d kept = eigen.eigenvalues().cwiseMax(0.0).cwiseMin(1.0);
+  return l * eigen.eigenvectors() * kept.asDiagonal() * eigen.eigenvectors().transpose() * l.transpose();
+}
+
 std::string joined(const std::vector<std::string>& errors)
 {
   std::string text;
@@ -162,16 +181,25 @@ Eigen::Matrix3d HypothesisTracker::fixNoise(const Hypothesis& h, const Pose2& pr
                                             std::size_t i) const
 {
   // A fix counts as one of k / stride overlapping batches, and with what it loses without any
-  // one direction (a person may shorten every reading of one sensor alike), unless a prediction
-  // as precise as a published pose agrees with it (TrackerOptions::fix_gate).
+  // one direction (a person may shorten every reading of one sensor alike); how far a prediction
+  // vouches for it or contradicts it: TrackerOptions::fix_gate.
   const Candidate& fix = found.fixes[i];
   const Eigen::Matrix3d own = options_.fix_covariance_scale * fix.covariance;
   const Eigen::Matrix3d loss = options_.fix_covariance_scale * found.direction_loss[i];
-  if (withinMargins(h.covariance) && squaredMahalanobis(fix.pose, predicted, h.covariance + own) <= options_.fix_gate)
+  if (options_.fix_gate <= 0.0)
   {
-    return own;
+    return own + loss;
   }
-  return own + loss;
+  if (squaredMahalanobis(fix.pose, predicted, h.covariance + own) > options_.fix_gate)
+  {
+    // Disagreeing: the fix or the prediction is wrong (a person read as a wall at a slant, an
+    // alike place in the box). It counts only up to its disagreement.
+    const Eigen::Vector3d d = poseDifference(fix.pose, predicted);
+    return own + loss + d * d.transpose();
+  }
+  // Agreeing with a prediction as precise as a published pose: what one direction alone fixes
+  // is checked only to the prediction's precision, and counts no more than it.
+  return withinMargins(h.covariance) ? own + cappedBy(loss, h.covariance) : own + loss;
 }
 
 bool HypothesisTracker::onlyPlace(const Eigen::Matrix3d& predicted, const PoseBox& box, const FusedPose& fused,

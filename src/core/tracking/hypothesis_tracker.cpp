@@ -4,6 +4,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <boost/math/distributions/chi_squared.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -31,6 +32,37 @@ Eigen::Matrix3d cappedBy(const Eigen::Matrix3d& m, const Eigen::Matrix3d& bound)
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(l_inv * m * l_inv.transpose());
   const Eigen::Vector3d kept = eigen.eigenvalues().cwiseMax(0.0).cwiseMin(1.0);
   return l * eigen.eigenvectors() * kept.asDiagonal() * eigen.eigenvectors().transpose() * l.transpose();
+}
+
+/// True when the innovation @p d (fix - prediction) [m, m, rad] fails the gate in the directions
+/// where the fix's precision comes from one direction's readings alone: those where @p loss
+/// exceeds @p covariance (the prediction's plus the fix's own), whitened by it. There the
+/// prediction is the fix's only witness, and its squared Mahalanobis distance over those r
+/// directions must stay within the chi-square quantile of r degrees of freedom at the
+/// probability @p gate has for 3 (6.63 for one direction at the 99 % of 11.34).
+bool disagreesAlone(const Eigen::Vector3d& d, const Eigen::Matrix3d& covariance, const Eigen::Matrix3d& loss,
+                    double gate)
+{
+  const Eigen::LLT<Eigen::Matrix3d> llt(covariance);
+  if (llt.info() != Eigen::Success || !d.allFinite() || !loss.allFinite())
+  {
+    return false;
+  }
+  const Eigen::Matrix3d l_inv = Eigen::Matrix3d(llt.matrixL()).inverse();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(l_inv * loss * l_inv.transpose());
+  const Eigen::Vector3d w = l_inv * d;
+  double m2 = 0.0;
+  int r = 0;
+  for (int j = 0; j < 3; ++j)
+  {
+    if (eigen.eigenvalues()(j) > 1.0)
+    {
+      m2 += std::pow(eigen.eigenvectors().col(j).dot(w), 2);
+      ++r;
+    }
+  }
+  const double p = boost::math::cdf(boost::math::chi_squared(3.0), gate);
+  return r > 0 && p < 1.0 - 1e-12 && m2 > boost::math::quantile(boost::math::chi_squared(r), p);
 }
 
 std::string joined(const std::vector<std::string>& errors)
@@ -190,11 +222,12 @@ Eigen::Matrix3d HypothesisTracker::fixNoise(const Hypothesis& h, const Pose2& pr
   {
     return own + loss;
   }
-  if (squaredMahalanobis(fix.pose, predicted, h.covariance + own) > options_.fix_gate)
+  const Eigen::Vector3d d = poseDifference(fix.pose, predicted);
+  if (squaredMahalanobis(fix.pose, predicted, h.covariance + own) > options_.fix_gate ||
+      (withinMargins(h.covariance) && disagreesAlone(d, h.covariance + own, loss, options_.fix_gate)))
   {
     // Disagreeing: the fix or the prediction is wrong (a person read as a wall at a slant, an
     // alike place in the box). It counts only up to its disagreement.
-    const Eigen::Vector3d d = poseDifference(fix.pose, predicted);
     return own + loss + d * d.transpose();
   }
   // Agreeing with a prediction as precise as a published pose: what one direction alone fixes

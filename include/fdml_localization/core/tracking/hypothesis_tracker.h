@@ -94,7 +94,9 @@ struct TrackerOptions
   /// ... except where the hypothesis already holds that precision: while its covariance is
   /// within the publishing margins (publish_max_xy, publish_max_theta), a fix whose squared
   /// Mahalanobis distance from the prediction (under the prediction's covariance plus the fix's
-  /// own) is at most this counts that loss only up to the prediction's covariance. The
+  /// own) is at most this, and at most the quantile of the same probability over the r
+  /// directions the loss alone fixes (chi-square, r degrees of freedom), counts that loss only
+  /// up to the prediction's covariance. The
   /// prediction, fixed by earlier updates under this rule and carried by odometry, is then a
   /// second witness (to its own precision, no further): one sensor agreeing with it keeps a
   /// direction fixed (a corridor's end wall, one side while a person walks along the other). A

@@ -14,6 +14,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace fdml_test
@@ -200,6 +201,18 @@ inline core::ObstacleGroupConfig walkers(int count, double radius, double speed)
   g.radius = radius;
   g.motion = core::ObstacleMotion::RandomWalk;
   g.speed = speed;
+  return g;
+}
+
+/// @p count people pacing the polyline @p waypoints [m] at @p speed [m/s], discs of @p radius [m].
+inline core::ObstacleGroupConfig pacers(int count, double radius, double speed, std::vector<core::Vec2> waypoints)
+{
+  core::ObstacleGroupConfig g;
+  g.count = count;
+  g.radius = radius;
+  g.motion = core::ObstacleMotion::Waypoints;
+  g.speed = speed;
+  g.waypoints = std::move(waypoints);
   return g;
 }
 

@@ -252,11 +252,7 @@ int wrongPublishedBehindAPerson(double direction_group, int* published)
 {
   const auto map = std::make_shared<const core::MapRayCaster>(corridor());
   core::ScenarioConfig c = fdml_test::waypointScenario({ { 10.0, 1.0 }, { 17.0, 1.0 } }, 8.0, 0.01, 7);
-  core::ObstacleGroupConfig person;
-  person.radius = 0.25;
-  person.motion = core::ObstacleMotion::Waypoints;
-  person.speed = c.robot.linear_speed;
-  person.waypoints = { { 11.2, 1.0 }, { 18.2, 1.0 } };
+  core::ObstacleGroupConfig person = fdml_test::pacers(1, 0.25, c.robot.linear_speed, { { 11.2, 1.0 }, { 18.2, 1.0 } });
   person.positions = { { 11.2, 1.0 } };
   c.obstacles.push_back(person);
   Drive drive(fdml_test::simulate(c, map), 10, 2);

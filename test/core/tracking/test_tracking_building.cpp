@@ -34,16 +34,9 @@ core::ScenarioConfig buildingDrive()
   {
     s.dropout = 0.02;
   }
-  core::ObstacleGroupConfig corridor;
-  corridor.count = 2;
-  corridor.radius = 0.25;
-  corridor.motion = core::ObstacleMotion::Waypoints;
-  corridor.speed = 0.7;
-  corridor.waypoints = { { 2.0, 6.3 }, { 30.0, 6.3 } };
-  c.obstacles.push_back(corridor);
-  corridor.speed = 0.6;
-  corridor.waypoints = { { 38.2, 15.0 }, { 38.2, 32.9 }, { 10.0, 32.9 }, { 38.2, 32.9 } };
-  c.obstacles.push_back(corridor);
+  c.obstacles.push_back(fdml_test::pacers(2, 0.25, 0.7, { { 2.0, 6.3 }, { 30.0, 6.3 } }));
+  c.obstacles.push_back(
+      fdml_test::pacers(2, 0.25, 0.6, { { 38.2, 15.0 }, { 38.2, 32.9 }, { 10.0, 32.9 }, { 38.2, 32.9 } }));
   c.obstacles.push_back(fdml_test::walkers(6, 0.25, 0.5));
   return c;
 }

@@ -34,16 +34,8 @@ core::ScenarioConfig officeMoving(std::uint64_t seed)
     s.noise_sigma = 0.02;
     s.dropout = 0.05;
   }
-  core::ObstacleGroupConfig corridor;
-  corridor.count = 2;
-  corridor.radius = 0.25;
-  corridor.motion = core::ObstacleMotion::Waypoints;
-  corridor.speed = 0.9;
-  corridor.waypoints = { { 1.0, 5.15 }, { 17.0, 5.15 } };
-  c.obstacles.push_back(corridor);
-  corridor.speed = 0.7;
-  corridor.waypoints = { { 16.5, 6.25 }, { 1.0, 6.25 } };
-  c.obstacles.push_back(corridor);
+  c.obstacles.push_back(fdml_test::pacers(2, 0.25, 0.9, { { 1.0, 5.15 }, { 17.0, 5.15 } }));
+  c.obstacles.push_back(fdml_test::pacers(2, 0.25, 0.7, { { 16.5, 6.25 }, { 1.0, 6.25 } }));
   c.obstacles.push_back(fdml_test::walkers(6, 0.25, 0.6));
   return c;
 }

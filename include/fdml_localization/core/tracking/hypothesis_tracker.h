@@ -96,14 +96,14 @@ struct TrackerOptions
   /// Mahalanobis distance from the prediction (under the prediction's covariance plus the fix's
   /// own) is at most this, and at most the quantile of the same probability over the r
   /// directions the loss alone fixes (chi-square, r degrees of freedom), counts that loss only
-  /// up to the prediction's covariance. The
-  /// prediction, fixed by earlier updates under this rule and carried by odometry, is then a
-  /// second witness (to its own precision, no further): one sensor agreeing with it keeps a
-  /// direction fixed (a corridor's end wall, one side while a person walks along the other). A
-  /// fix beyond the gate disagrees, whatever the hypothesis's precision: the fix or the
-  /// prediction is wrong (a person read as a wall at a slant), and the fix counts only up to its
-  /// disagreement (its covariance gains d d^T, d its difference from the prediction). 11.34:
-  /// 99 % of a true fix (3 degrees of freedom). [0, 1e6], 0 = never (every fix counts its loss).
+  /// up to the prediction's covariance. The prediction, fixed by earlier updates under this rule
+  /// and carried by odometry, is then a second witness (to its own precision, no further): one
+  /// sensor agreeing with it keeps a direction fixed (a corridor's end wall, one side while a
+  /// person walks along the other). A fix beyond the gate, or beyond that quantile while within
+  /// the margins, disagrees: the fix or the prediction is wrong (a person read as a wall at a
+  /// slant), and the fix counts only up to its disagreement (its covariance gains d d^T, d its
+  /// difference from the prediction [m, m, rad]). 11.34: 99 % of a true fix (3 degrees of
+  /// freedom). [0, 1e6], 0 = never (every fix counts its loss).
   double fix_gate = 11.34;
   /// Each fix's covariance is multiplied by this before it is fused, in [1, 1000]. Batches that
   /// slide by s of their k readings share k - s readings with the previous one, so their fixes

@@ -260,6 +260,28 @@ std::vector<LeafCluster> leafMaxima(const std::vector<LeafBox>& leaves, int leve
   return maxima;
 }
 
+std::vector<std::size_t> leavesToSearch(const std::vector<LeafBox>& leaves, const std::vector<int>& labels, int target,
+                                        std::size_t limit)
+{
+  std::vector<std::size_t> beyond, at;
+  for (std::size_t l = 0; l < leaves.size() && l < labels.size(); ++l)
+  {
+    if (labels[l] >= 0)
+    {
+      (leaves[l].count > target ? beyond : at).push_back(l);
+    }
+  }
+  std::stable_sort(beyond.begin(), beyond.end(),
+                   [&](std::size_t a, std::size_t b) { return leaves[a].count > leaves[b].count; });
+  beyond.resize(std::min(beyond.size(), limit));
+  const std::size_t step = std::max<std::size_t>(1, at.size() / std::max<std::size_t>(1, limit));
+  for (std::size_t j = 0; j < at.size(); j += step)
+  {
+    beyond.push_back(at[j]);
+  }
+  return beyond;
+}
+
 std::vector<int> leafComponents(const std::vector<LeafBox>& leaves, int level, std::int64_t theta_cells,
                                 int& components)
 {

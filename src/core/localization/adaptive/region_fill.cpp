@@ -17,9 +17,9 @@ namespace core
 {
 namespace
 {
-/// Leaves at the best consensus (spread over them) checked; those holding no candidate get
-/// their centre pose verified and are searched (searchLeafForPlace(); the order is
-/// fillUncoveredRegions()'s) ...
+/// Leaves at the best consensus (spread over them) checked, besides as many whose bound exceeds
+/// it; those holding no candidate get their centre pose verified and are searched
+/// (searchLeafForPlace(); the order is fillUncoveredRegions()'s) ...
 constexpr std::size_t kFillLeaves = 20000;
 /// ... at least this many of them (where as many are open) ...
 constexpr int kFillTries = 64;
@@ -143,12 +143,13 @@ void screenOpenLeaves(const MapRayCaster& map, const std::vector<Reading>& readi
   }
 }
 
-/// The leaves reaching @p target that hold no candidate's pose (at most kFillLeaves, spread over
-/// them), each with its centre verified, in the order they are searched: round robin over their
-/// connected regions (the best leaf of every region, then the second best, ...; the best centres
-/// first within a rank). A region's place may lie far from its leaves' centres, on a large map
-/// many separate regions reach the consensus (alike rooms, alcoves), and a continuum's candidate
-/// (sd of metres along a corridor) can be an approximate place while an exact one lies on it.
+/// The leaves reaching @p target that hold no candidate's pose (every one whose bound exceeds the
+/// target, the highest first, up to kFillLeaves; those at the target spread, leavesToSearch()),
+/// each with its centre verified, in the order they are searched: round robin over their connected
+/// regions (the best leaf of every region, then the second best, ...; the best centres first within
+/// a rank). A region's place may lie far from its leaves' centres, on a large map many separate
+/// regions reach the consensus (alike rooms, alcoves), and a continuum's candidate (sd of metres
+/// along a corridor) can be an approximate place while an exact one lies on it.
 std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<LeafBox>& leaves, int target,
                                  std::int64_t theta_cells, const std::vector<Reading>& readings,
                                  const std::vector<Candidate>& candidates, const LocalizerOptions& options)
@@ -160,25 +161,18 @@ std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<Leaf
   }
   int regions = 0;
   const std::vector<int> labels = leafComponents(leaves, target, theta_cells, regions);
-  std::vector<std::size_t> reaching;
-  for (std::size_t l = 0; l < leaves.size(); ++l)
-  {
-    if (labels[l] >= 0)
-    {
-      reaching.push_back(l);
-    }
-  }
-  const std::size_t step = std::max<std::size_t>(1, reaching.size() / kFillLeaves);
+  // Spread over all alike, the voxel engine's 147,000 voxels reaching 3 of 5 readings (turning
+  // in the warehouse) skipped the truth's, one of the few reaching 5.
   std::vector<OpenLeaf> open;
-  for (std::size_t j = 0; j < reaching.size(); j += step)
+  for (const std::size_t l : leavesToSearch(leaves, labels, target, kFillLeaves))
   {
-    const LeafBox& leaf = leaves[reaching[j]];
+    const LeafBox& leaf = leaves[l];
     // A leaf that may beat the candidates is open even where one's pose lies in it.
     if (leaf.count <= target && accounting.holds(leaf.box))
     {
       continue;
     }
-    OpenLeaf o{ &leaf, Candidate(), labels[reaching[j]], 0, leaf.count, Candidate() };
+    OpenLeaf o{ &leaf, Candidate(), labels[l], 0, leaf.count, Candidate() };
     o.rival.inliers = -1;
     if (const Candidate* rival = accounting.continuumAt(leaf.box))
     {

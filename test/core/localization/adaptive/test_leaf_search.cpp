@@ -1,12 +1,15 @@
 // The region fill's screen of a leaf (leaf_search.h): a screen that leaves no sub-box proves that
 // no pose of the leaf reaches the count, it proves so more often than the leaf's own box bound,
 // its ranking centre is a verified pose of the leaf, and its box tests are counted.
+#include "fdml_localization/core/localization/adaptive/leaf_clustering.h"
 #include "fdml_localization/core/localization/adaptive/leaf_search.h"
 #include "fdml_localization/core/localization/certificate.h"
 
 #include "localizer_test_utils.h"
 
 #include <gtest/gtest.h>
+
+#include <algorithm>
 
 namespace fdml_localization
 {
@@ -104,6 +107,55 @@ TEST(ScreenLeaf, ItsCentreIsAVerifiedPoseOfTheLeafNoWorseThanTheOneGiven)
     improved += betterCandidate(centre, given);
   }
   EXPECT_GT(improved, 20);
+}
+
+// The fill's choice of leaves (leavesToSearch()): every leaf that may beat the best place is kept,
+// the highest counts first, however many reach the best place's count; the rest are spread.
+TEST(LeavesToSearch, KeepsEveryLeafBeyondTheTargetAndSpreadsTheRest)
+{
+  std::mt19937_64 rng(7);
+  std::vector<LeafBox> leaves(150000);
+  std::vector<int> labels(leaves.size(), 0);
+  for (LeafBox& l : leaves)
+  {
+    l.count = 3;
+  }
+  std::uniform_int_distribution<std::size_t> pick(0, leaves.size() - 1);
+  std::vector<std::size_t> beyond;
+  for (int j = 0; j < 12; ++j)
+  {
+    const std::size_t l = pick(rng);
+    leaves[l].count = 4 + j % 2;
+    beyond.push_back(l);
+  }
+  labels[beyond.back()] = -1;  // in no component at the target: never searched
+  std::sort(beyond.begin(), beyond.end());
+  beyond.erase(std::unique(beyond.begin(), beyond.end()), beyond.end());
+  const std::vector<std::size_t> chosen = leavesToSearch(leaves, labels, 3, 1000);
+  std::size_t first_at_target = 0;
+  while (first_at_target < chosen.size() && leaves[chosen[first_at_target]].count > 3)
+  {
+    ++first_at_target;
+  }
+  for (std::size_t l : beyond)
+  {
+    const bool kept = std::find(chosen.begin(), chosen.end(), l) != chosen.end();
+    EXPECT_EQ(kept, labels[l] >= 0) << "leaf " << l;
+  }
+  EXPECT_EQ(first_at_target, static_cast<std::size_t>(std::count_if(beyond.begin(), beyond.end(),
+                                                                    [&](std::size_t l) { return labels[l] >= 0; })));
+  for (std::size_t j = 1; j < first_at_target; ++j)
+  {
+    EXPECT_GE(leaves[chosen[j - 1]].count, leaves[chosen[j]].count);
+  }
+  const std::size_t spread = chosen.size() - first_at_target;
+  EXPECT_GE(spread, 1000u);
+  EXPECT_LT(spread, 2000u);
+  // The leaves beyond the target are capped at the limit too, the highest kept.
+  const std::vector<std::size_t> capped = leavesToSearch(leaves, labels, 3, 2);
+  ASSERT_GE(capped.size(), 2u);
+  EXPECT_EQ(leaves[capped[0]].count, 5);
+  EXPECT_EQ(leaves[capped[1]].count, 5);
 }
 
 }  // namespace

@@ -50,6 +50,16 @@ std::int64_t thetaCells(double cell_theta);
 std::vector<int> leafComponents(const std::vector<LeafBox>& leaves, int level, std::int64_t theta_cells,
                                 int& components);
 
+/**
+ * @brief The leaves of a component (@p labels >= 0, leafComponents()) worth searching for a
+ *        place explaining @p target readings: every one whose count exceeds it (it may beat
+ *        the best place found), the highest counts first, up to @p limit; then those at
+ *        @p target, every one or, where there are more than @p limit, every n-th (at least
+ *        @p limit, fewer than twice as many). Indices into @p leaves.
+ */
+std::vector<std::size_t> leavesToSearch(const std::vector<LeafBox>& leaves, const std::vector<int>& labels, int target,
+                                        std::size_t limit);
+
 /// The box of poses of voxel @p v of @p spec: its cell [m] by its heading step [rad] (from -pi).
 PoseBox voxelBox(const GridSpec& spec, std::size_t v);
 

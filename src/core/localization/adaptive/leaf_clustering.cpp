@@ -273,13 +273,30 @@ std::vector<std::size_t> leavesToSearch(const std::vector<LeafBox>& leaves, cons
   }
   std::stable_sort(beyond.begin(), beyond.end(),
                    [&](std::size_t a, std::size_t b) { return leaves[a].count > leaves[b].count; });
-  beyond.resize(std::min(beyond.size(), limit));
+  // Whole bounds while they fit; the one that overflows spread over its leaves (taken in index
+  // order they would all lie at one end of the map).
+  std::vector<std::size_t> chosen;
+  for (std::size_t first = 0; first < beyond.size() && chosen.size() < limit;)
+  {
+    std::size_t last = first;
+    while (last < beyond.size() && leaves[beyond[last]].count == leaves[beyond[first]].count)
+    {
+      ++last;
+    }
+    const std::size_t room = limit - chosen.size();
+    const std::size_t step = (last - first + room - 1) / room;
+    for (std::size_t j = first; j < last; j += step)
+    {
+      chosen.push_back(beyond[j]);
+    }
+    first = last;
+  }
   const std::size_t step = std::max<std::size_t>(1, at.size() / std::max<std::size_t>(1, limit));
   for (std::size_t j = 0; j < at.size(); j += step)
   {
-    beyond.push_back(at[j]);
+    chosen.push_back(at[j]);
   }
-  return beyond;
+  return chosen;
 }
 
 std::vector<int> leafComponents(const std::vector<LeafBox>& leaves, int level, std::int64_t theta_cells,

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <iterator>
 
 namespace fdml_localization
 {
@@ -156,6 +157,18 @@ TEST(LeavesToSearch, KeepsEveryLeafBeyondTheTargetAndSpreadsTheRest)
   ASSERT_GE(capped.size(), 2u);
   EXPECT_EQ(leaves[capped[0]].count, 5);
   EXPECT_EQ(leaves[capped[1]].count, 5);
+  // A bound whose leaves overflow the limit is spread over them, not taken from one end.
+  for (std::size_t l = 0; l < leaves.size(); ++l)
+  {
+    leaves[l].count = l % 4 == 0 ? 4 : 3;
+  }
+  const std::vector<std::size_t> overflow = leavesToSearch(leaves, labels, 3, 1000);
+  std::vector<std::size_t> kept_beyond;
+  std::copy_if(overflow.begin(), overflow.end(), std::back_inserter(kept_beyond),
+               [&](std::size_t l) { return leaves[l].count == 4; });
+  EXPECT_LE(kept_beyond.size(), 1000u);
+  EXPECT_GE(kept_beyond.size(), 900u);
+  EXPECT_GT(*std::max_element(kept_beyond.begin(), kept_beyond.end()), leaves.size() * 9 / 10);
 }
 
 }  // namespace

@@ -53,7 +53,8 @@ std::vector<int> leafComponents(const std::vector<LeafBox>& leaves, int level, s
 /**
  * @brief The leaves of a component (@p labels >= 0, leafComponents()) worth searching for a
  *        place explaining @p target readings: every one whose count exceeds it (it may beat
- *        the best place found), the highest counts first, up to @p limit; then those at
+ *        the best place found), the highest counts first, up to @p limit (a count whose
+ *        leaves overflow it spread evenly over them); then those at
  *        @p target, every one or, where there are more than @p limit, every n-th (at least
  *        @p limit, fewer than twice as many). Indices into @p leaves.
  */

@@ -2,6 +2,7 @@
 #include "fdml_localization/core/localization/certificate.h"
 
 #include "fdml_localization/core/localization/adaptive/leaf_clustering.h"
+#include "fdml_localization/core/localization/adaptive/leaf_search.h"
 #include "fdml_localization/core/localization/components.h"
 #include "fdml_localization/core/localization/robust_search.h"
 
@@ -19,33 +20,6 @@ namespace
 constexpr int kExclusionDepth = 3;
 /// Box tests the exclusion of all regions may spend.
 constexpr long kExclusionBudget = 20000;
-
-/// True when some sub-box of @p box, halved @p depth times along every axis, may still explain
-/// @p needed readings (or the budget ran out).
-bool mayReach(const MapRayCaster& map, const std::vector<Reading>& readings, double tolerance, const PoseBox& box,
-              int needed, int depth, long& budget)
-{
-  if (--budget < 0)
-  {
-    return true;
-  }
-  if (boxConsensusBound(map, readings, tolerance, box, needed) < needed)
-  {
-    return false;
-  }
-  if (depth == 0)
-  {
-    return true;
-  }
-  for (int c = 0; c < 8; ++c)
-  {
-    if (mayReach(map, readings, tolerance, box.half(c), needed, depth - 1, budget))
-    {
-      return true;
-    }
-  }
-  return false;
-}
 
 /// The boxes reaching the bound, with the region each belongs to.
 struct BoundRegions
@@ -85,7 +59,10 @@ void certify(const MapRayCaster& map, const std::vector<Reading>& readings, doub
     const std::size_t r = static_cast<std::size_t>(regions.region[b]);
     if (!covered[r] && !reachable[r])
     {
-      reachable[r] = mayReach(map, readings, tolerance, regions.boxes[b], bound, kExclusionDepth, budget) ? 1 : 0;
+      PoseBox sub_box;
+      reachable[r] =
+          firstSubBoxReaching(map, readings, tolerance, regions.boxes[b], bound, kExclusionDepth, budget, sub_box) ? 1 :
+                                                                                                                     0;
     }
   }
   c.regions_excluded =

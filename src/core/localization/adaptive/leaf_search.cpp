@@ -181,6 +181,49 @@ Candidate searchLeafForPlace(const MapRayCaster& map, const LeafBox& leaf, const
   return refined;
 }
 
+bool firstSubBoxReaching(const MapRayCaster& map, const std::vector<Reading>& readings, double tolerance,
+                         const PoseBox& box, int needed, int depth, long& budget, PoseBox& found)
+{
+  if (budget-- <= 0)
+  {
+    found = box;
+    return true;
+  }
+  if (boxConsensusBound(map, readings, tolerance, box, needed) < needed)
+  {
+    return false;
+  }
+  if (depth == 0)
+  {
+    found = box;
+    return true;
+  }
+  for (int c = 0; c < 8; ++c)
+  {
+    if (firstSubBoxReaching(map, readings, tolerance, box.half(c), needed, depth - 1, budget, found))
+    {
+      return true;
+    }
+  }
+  return false;
+}
+
+bool probeLeaf(const MapRayCaster& map, const PoseBox& leaf, const std::vector<Reading>& readings,
+               const LocalizerOptions& options, int needed, int depth, Candidate& centre, long& box_tests)
+{
+  PoseBox found;
+  if (!firstSubBoxReaching(map, readings, options.range_tolerance, leaf, needed, depth, box_tests, found))
+  {
+    return false;
+  }
+  if (centre.inliers >= 0)
+  {
+    Candidate c = verifiedCandidate(map, found.centre(), readings, options.agreement_tolerance);
+    centre = betterCandidate(c, centre) ? std::move(c) : centre;
+  }
+  return true;
+}
+
 bool screenLeaf(const MapRayCaster& map, const PoseBox& leaf, const std::vector<Reading>& readings,
                 const LocalizerOptions& options, int needed, int depth, Candidate& centre, long& box_tests)
 {

@@ -33,6 +33,8 @@ constexpr long kBeyondBoxTests = 50000;
 constexpr long kScreenBoxTests = 100000;
 /// ... each leaf halved this many times (a 62 cm, 5.6 deg leaf down to 7.8 cm, 0.7 deg).
 constexpr int kScreenDepth = 3;
+/// Box tests the probes of the open leaves at the best candidate's consensus may spend in all.
+constexpr long kProbeBoxTests = 100000;
 /// A place found this many leaves (in x, y and heading) from a candidate is that candidate's.
 constexpr double kNearLeaves = 3.0;
 /// A leaf's centre within this squared Mahalanobis distance of a candidate is its (chi-square,
@@ -62,11 +64,6 @@ public:
       return box.contains(e.candidate.pose, options_.uniqueness_distance, options_.uniqueness_angle);
     });
     return e == entries_.end() ? nullptr : &e->candidate;
-  }
-
-  bool holds(const PoseBox& box) const
-  {
-    return holder(box) != nullptr;
   }
 
   /// The candidate whose continuum reaches @p box's centre, or null.
@@ -123,8 +120,11 @@ struct OpenLeaf
 /// tightened, their centre the best of their deepest sub-boxes'. Box tests are cheap beside the
 /// verifications and refinements of a leaf's search, and most such leaves hold no place (in a
 /// corridor with 13 short no-returns of 16 readings, 305 of 5,251 keep a sub-box 7.8 cm wide).
-/// Leaves at the target are left as they are: screening them too cost a quarter more time where
-/// readings are mostly no-returns and found no more places.
+/// Leaves at the target are probed instead (probeLeaf(), in their spread order while
+/// kProbeBoxTests last): a screen costs a quarter more time where readings are mostly no-returns.
+/// In a floor plan of half-metre corridors, 2,392 of 3,879 leaves held no sub-box reaching the
+/// target, and the truth's leaf, its centre explaining none of 6 readings, ranked 29th in its
+/// region and was never searched; probed, its centre explains 6 and it ranks first.
 void screenOpenLeaves(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
                       int target, std::vector<OpenLeaf>& open)
 {
@@ -140,6 +140,13 @@ void screenOpenLeaves(const MapRayCaster& map, const std::vector<Reading>& readi
     {
       --o.bound;
     }
+  }
+  budget = kProbeBoxTests;
+  for (auto o = open.begin(); o != open.end() && budget > 0; ++o)
+  {
+    const bool none =
+        o->bound == target && !probeLeaf(map, o->leaf->box, readings, options, target, kScreenDepth, o->centre, budget);
+    o->bound -= none ? 1 : 0;
   }
 }
 
@@ -168,7 +175,7 @@ std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<Leaf
   {
     const LeafBox& leaf = leaves[l];
     // A leaf that may beat the candidates is open even where one's pose lies in it.
-    if (leaf.count <= target && accounting.holds(leaf.box))
+    if (leaf.count <= target && accounting.holder(leaf.box) != nullptr)
     {
       continue;
     }

@@ -1,6 +1,7 @@
-// The region fill's screen of a leaf (leaf_search.h): a screen that leaves no sub-box proves that
-// no pose of the leaf reaches the count, it proves so more often than the leaf's own box bound,
-// its ranking centre is a verified pose of the leaf, and its box tests are counted.
+// The region fill's screen and probe of a leaf (leaf_search.h): a screen that leaves no sub-box
+// proves that no pose of the leaf reaches the count, it proves so more often than the leaf's own
+// box bound, its ranking centre is a verified pose of the leaf, and its box tests are counted; the
+// probe answers as the screen does.
 #include "fdml_localization/core/localization/adaptive/leaf_clustering.h"
 #include "fdml_localization/core/localization/adaptive/leaf_search.h"
 #include "fdml_localization/core/localization/certificate.h"
@@ -107,6 +108,60 @@ TEST(ScreenLeaf, ItsCentreIsAVerifiedPoseOfTheLeafNoWorseThanTheOneGiven)
     EXPECT_FALSE(betterCandidate(given, centre)) << "trial " << trial;
     improved += betterCandidate(centre, given);
   }
+  EXPECT_GT(improved, 20);
+}
+
+// The probe of a leaf at the fill's target (probeLeaf(), firstSubBoxReaching()): it answers as the
+// screen does (both test the same sub-boxes, the probe depth first up to the first that reaches),
+// for no more box tests; a "no" holds for a lattice of the leaf's poses; a "yes" names a sub-box of
+// the leaf, three halvings down, whose bound reaches the count, and its centre is a verified pose
+// of the leaf no worse than the one given.
+TEST(ProbeLeaf, AnswersAsTheScreenForFewerBoxTestsAndNamesASubBoxReachingTheCount)
+{
+  const auto map = test::loadMap("maps/apartment.poly");
+  LocalizerOptions options;
+  options.range_tolerance = 0.03;
+  std::mt19937_64 rng(79);
+  int no = 0, yes = 0, improved = 0;
+  for (int trial = 0; trial < 300; ++trial)
+  {
+    const ScreenCase c = randomCase(*map, rng);
+    const Candidate given = verifiedCandidate(*map, c.box.centre(), c.readings, options.agreement_tolerance);
+    for (int needed = 4; needed <= 6; ++needed)
+    {
+      Candidate screened = given, probed = given;
+      long screen_tests = 0, probe_tests = 100000;  // the probe's budget is ample
+      const bool screen = screenLeaf(*map, c.box, c.readings, options, needed, 3, screened, screen_tests);
+      const bool probe = probeLeaf(*map, c.box, c.readings, options, needed, 3, probed, probe_tests);
+      ASSERT_EQ(probe, screen) << "trial " << trial << " needed " << needed;
+      EXPECT_LE(100000 - probe_tests, 1 - screen_tests);  // the screen does not count the leaf's own test
+      ASSERT_TRUE(c.box.contains(probed.pose, 1e-9, 1e-9)) << "trial " << trial;
+      EXPECT_FALSE(betterCandidate(given, probed));
+      improved += betterCandidate(probed, given);
+      long budget = 1000;
+      PoseBox found;
+      ASSERT_EQ(firstSubBoxReaching(*map, c.readings, options.range_tolerance, c.box, needed, 3, budget, found), probe);
+      if (!probe)
+      {
+        ++no;
+        for (int i = 0; i < 7 * 7 * 7; ++i)
+        {
+          const Pose2 pose(c.box.x0 + (c.box.x1 - c.box.x0) * (i % 7) / 6.0,
+                           c.box.y0 + (c.box.y1 - c.box.y0) * (i / 7 % 7) / 6.0,
+                           c.box.t0 + (c.box.t1 - c.box.t0) * (i / 49) / 6.0);
+          ASSERT_LT(consensusWithin(*map, pose, c.readings, options.range_tolerance), needed) << "trial " << trial;
+        }
+        continue;
+      }
+      ++yes;
+      EXPECT_NEAR(found.x1 - found.x0, (c.box.x1 - c.box.x0) / 8.0, 1e-12);
+      EXPECT_NEAR(found.t1 - found.t0, (c.box.t1 - c.box.t0) / 8.0, 1e-12);
+      EXPECT_TRUE(c.box.contains(found.centre(), 1e-9, 1e-9));
+      EXPECT_GE(boxConsensusBound(*map, c.readings, options.range_tolerance, found, needed), needed);
+    }
+  }
+  EXPECT_GT(no, 100);
+  EXPECT_GT(yes, 100);
   EXPECT_GT(improved, 20);
 }
 

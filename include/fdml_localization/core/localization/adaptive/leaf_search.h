@@ -61,6 +61,30 @@ Candidate searchLeafForPlace(const MapRayCaster& map, const LeafBox& leaf, const
                              const RefinementSettings& settings, int target, long& box_tests);
 
 /**
+ * @brief The first sub-box of @p box, @p depth halvings of every axis down, that may explain
+ *        @p needed readings (boxConsensusBound(), band @p tolerance [m]), searched depth first:
+ *        none, and no pose in @p box explains that many. The certificate's exclusion of a region
+ *        and the region fill's probe of a leaf (probeLeaf()).
+ * @param budget counted down by the box tests made; once spent, the box at hand counts as
+ *        reaching (the answer stays conservative)
+ * @param found set to that sub-box when the answer is true
+ */
+bool firstSubBoxReaching(const MapRayCaster& map, const std::vector<Reading>& readings, double tolerance,
+                         const PoseBox& box, int needed, int depth, long& budget, PoseBox& found);
+
+/**
+ * @brief The probe of a leaf at the region fill's target: firstSubBoxReaching() @p needed
+ *        readings (range_tolerance) @p depth halvings down. None: false. Else @p centre (when
+ *        verified, inliers >= 0) becomes that sub-box's verified centre where better. Cheaper than
+ *        screenLeaf() (one sub-box, not all): where ranges are short beside a leaf (corridors
+ *        half a metre wide, 14 cm leaves), a leaf's own centre explains none of the readings its
+ *        place explains, and most leaves reaching the target hold no sub-box that does.
+ * @param box_tests counted down by the box tests made
+ */
+bool probeLeaf(const MapRayCaster& map, const PoseBox& leaf, const std::vector<Reading>& readings,
+               const LocalizerOptions& options, int needed, int depth, Candidate& centre, long& box_tests);
+
+/**
  * @brief The screen of a leaf before its search: its sub-boxes @p depth halvings of every axis
  *        down that may explain @p needed readings, by box tests alone (boxConsensusBound(),
  *        range_tolerance). None left: no pose in @p leaf explains that many. Else @p centre

@@ -28,8 +28,9 @@ namespace core
  *        box holds no candidate's pose (within the uniqueness margins); a leaf whose centre lies
  *        within 3 sigma of a candidate's covariance grown by the leaf's size is on its continuum.
  *        Those whose bound exceeds the consensus are screened first (screenLeaf(), three
- *        halvings, 100,000 box tests in all): a leaf with no sub-box reaching its bound has its
- *        bound lowered by one, the others are ranked by their best sub-box centre. Searched
+ *        halvings, 100,000 box tests in all), those at it probed (probeLeaf(), another 100,000): a
+ *        leaf with no sub-box reaching its bound has its bound lowered by one, the others are
+ *        ranked by their best (probed: first) sub-box centre where better than theirs. Searched
  *        first the leaves whose bound exceeds the consensus (highest first; a place
  *        there raises it), then round robin over their connected regions (26 neighbours,
  *        @p theta_cells heading cells around the circle: every region's best leaf by its centre,

@@ -59,10 +59,10 @@ void certify(const MapRayCaster& map, const std::vector<Reading>& readings, doub
     const std::size_t r = static_cast<std::size_t>(regions.region[b]);
     if (!covered[r] && !reachable[r])
     {
-      PoseBox sub_box;
-      reachable[r] =
-          firstSubBoxReaching(map, readings, tolerance, regions.boxes[b], bound, kExclusionDepth, budget, sub_box) ? 1 :
-                                                                                                                     0;
+      PoseBox sub_box;  // which sub-box reaches does not matter here
+      const bool reaches =
+          firstSubBoxReaching(map, readings, tolerance, regions.boxes[b], bound, kExclusionDepth, budget, sub_box);
+      reachable[r] = reaches ? 1 : 0;
     }
   }
   c.regions_excluded =

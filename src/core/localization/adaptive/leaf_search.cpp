@@ -219,7 +219,10 @@ bool probeLeaf(const MapRayCaster& map, const PoseBox& leaf, const std::vector<R
   if (centre.inliers >= 0)
   {
     Candidate c = verifiedCandidate(map, found.centre(), readings, options.agreement_tolerance);
-    centre = betterCandidate(c, centre) ? std::move(c) : centre;
+    if (betterCandidate(c, centre))
+    {
+      centre = std::move(c);
+    }
   }
   return true;
 }

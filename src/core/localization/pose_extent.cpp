@@ -210,9 +210,6 @@ std::vector<Pose2> residualRoots(const MapRayCaster& map, const std::vector<Read
   return roots;
 }
 
-/// An RMS below this is exact: the rounding of a polish [m].
-constexpr double kExactRms = 1e-6;
-
 /// A direction is a continuum where the candidate's standard deviation along it exceeds this
 /// many times the noise ([m], or [rad] per metre of it for the heading).
 constexpr double kContinuumSpread = 3.0;
@@ -221,7 +218,8 @@ constexpr double kContinuumSpread = 3.0;
 /// corridor with range noise, one reading's root moves the RMS by a fraction of the noise.
 constexpr double kEndGain = 0.5;
 
-/// The pose polished from @p start on @p candidate's finite inliers, as a candidate.
+}  // namespace
+
 Candidate polishedFrom(const MapRayCaster& map, const std::vector<Reading>& readings,
                        const RefinementSettings& settings, const Candidate& candidate, const Pose2& start)
 {
@@ -237,7 +235,6 @@ Candidate polishedFrom(const MapRayCaster& map, const std::vector<Reading>& read
   c.support = candidate.support;
   return c;
 }
-}  // namespace
 
 void widenAlongContinua(const MapRayCaster& map, const std::vector<Reading>& readings, double noise,
                         Candidate& candidate)

@@ -8,8 +8,6 @@ namespace fdml_localization
 {
 namespace core
 {
-namespace
-{
 double medianFiniteRange(const std::vector<Reading>& readings)
 {
   std::vector<double> finite;
@@ -27,7 +25,6 @@ double medianFiniteRange(const std::vector<Reading>& readings)
   std::nth_element(finite.begin(), finite.begin() + finite.size() / 2, finite.end());
   return finite[finite.size() / 2];
 }
-}  // namespace
 
 double seedGate(const std::vector<Reading>& readings, const LocalizerOptions& options, const SeedScale& scale)
 {

@@ -24,6 +24,9 @@ struct SeedScale
   double cell_theta = 0.1;  ///< cell or leaf size [rad]
 };
 
+/// The median of the readings' finite ranges [m]; 1 m when none is finite.
+double medianFiniteRange(const std::vector<Reading>& readings);
+
 /**
  * @brief The loose agreement band [m] at a seed's start: 3 x the robust scale of the first
  *        polish, max(eps, half a cell + half a cell's angle x the median finite range). Seeds

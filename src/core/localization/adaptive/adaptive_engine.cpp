@@ -233,8 +233,9 @@ void AdaptiveEngine::localizeRobust(AdaptiveSearch& search, const std::vector<Re
   searchNoReturnRegion(search, readings, result);
   const auto stage = std::chrono::steady_clock::now();
   const std::int64_t theta_cells = thetaCells(cell_theta_);
-  fillUncoveredRegions(*map_, search.result().leaves, theta_cells, readings, options_,
-                       latticeRefinement(options_, cell_xy_, cell_theta_), result);
+  const RefinementSettings settings = latticeRefinement(options_, cell_xy_, cell_theta_);
+  fillUncoveredRegions(*map_, search.result().leaves, theta_cells, readings, options_, settings, result);
+  settleInNearBasins(*map_, readings, options_, settings, result.candidates);
   result.times.polish += secondsSince(stage);
 }
 

@@ -206,8 +206,9 @@ void VoxelEngine::localizeRobust(const std::vector<Reading>& readings, Result& r
     }
     leaves.erase(std::remove_if(leaves.begin(), leaves.end(), [&](const LeafBox& l) { return l.count < target; }),
                  leaves.end());
-    fillUncoveredRegions(*map_, leaves, spec_.nt, readings, options_,
-                         latticeRefinement(options_, spec_.cell, spec_.thetaStep()), result);
+    const RefinementSettings settings = latticeRefinement(options_, spec_.cell, spec_.thetaStep());
+    fillUncoveredRegions(*map_, leaves, spec_.nt, readings, options_, settings, result);
+    settleInNearBasins(*map_, readings, options_, settings, result.candidates);
   }
   result.times.polish += secondsSince(fill);
 }

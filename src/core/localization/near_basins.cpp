@@ -1,0 +1,115 @@
+// settleInNearBasins() (robust_search.h): the candidates' last polish, from a fine lattice around
+// them, where a ray passing a vertex splits the cost into basins a centimetre wide.
+#include "fdml_localization/core/localization/region_starts.h"
+#include "fdml_localization/core/localization/robust_search.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace fdml_localization
+{
+namespace core
+{
+namespace
+{
+/// Lattice rounds of settleInNearBasins() around a candidate, each around the better pose found.
+constexpr int kNearBasinRounds = 3;
+
+/// True when the cost may jump within about a lattice @p step_xy [m], @p step_theta [rad] of
+/// @p candidate: a finite inlier's ray passes a vertex within the move of its sensor there
+/// (vertexMargins()), or a reading is a cone (its nearest point can jump). Elsewhere the cost is
+/// smooth around the candidate and its polish already reached that basin's least residual.
+bool nearAnEdge(const MapRayCaster& map, const std::vector<Reading>& readings, const Candidate& candidate,
+                double step_xy, double step_theta)
+{
+  const std::vector<double> margins = vertexMargins(map, candidate.pose, readings, step_theta);
+  for (std::size_t i = 0; i < readings.size(); ++i)
+  {
+    const Reading& r = readings[i];
+    const double moved = 2.0 * step_xy + r.offset.position().norm() * step_theta;
+    if (r.half_angle > 0.0 || (candidate.inlier_mask[i] && margins[i] < moved))
+    {
+      return true;
+    }
+  }
+  return false;
+}
+
+/// @p candidate moved to the best pose polished from the 26 poses of a lattice @p step_xy [m],
+/// @p step_theta [rad] around it, while that is better and half a step away or more and the
+/// candidate is near an edge of the cost (nearAnEdge()), kNearBasinRounds times at most.
+void settleInNearBasin(const MapRayCaster& map, const std::vector<Reading>& readings,
+                       const RefinementSettings& settings, double step_xy, double step_theta, Candidate& candidate)
+{
+  for (int round = 0; round < kNearBasinRounds && candidate.rms_residual >= kExactRms &&
+                      nearAnEdge(map, readings, candidate, step_xy, step_theta);
+       ++round)
+  {
+    Candidate best = candidate;
+    for (int a = -1; a <= 1; ++a)
+    {
+      for (int b = -1; b <= 1; ++b)
+      {
+        for (int c = -1; c <= 1; ++c)
+        {
+          if (a == 0 && b == 0 && c == 0)
+          {
+            continue;
+          }
+          const Pose2& q = candidate.pose;
+          const Pose2 start(q.x + a * step_xy, q.y + b * step_xy, wrapAngle(q.theta + c * step_theta));
+          Candidate polished = polishedFrom(map, readings, settings, candidate, start);
+          if (betterCandidate(polished, best))
+          {
+            best = std::move(polished);
+          }
+        }
+      }
+    }
+    if (!betterCandidate(best, candidate))
+    {
+      return;
+    }
+    // A move of less than half a step found the same basin again: no new lattice.
+    const Eigen::Vector3d d = poseDifference(best.pose, candidate.pose);
+    const bool far = d.head<2>().norm() >= 0.5 * step_xy || std::abs(d.z()) >= 0.5 * step_theta;
+    best.covariance = candidate.covariance;  // widened along continua, tied duplicates absorbed
+    candidate = std::move(best);
+    if (!far)
+    {
+      return;
+    }
+  }
+}
+}  // namespace
+
+void settleInNearBasins(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
+                        const RefinementSettings& settings, std::vector<Candidate>& candidates)
+{
+  if (candidates.empty())
+  {
+    return;
+  }
+  const double step_xy = 0.5 * options.range_tolerance;
+  const double step_theta = std::min(step_xy / medianFiniteRange(readings), 0.25 * options.uniqueness_angle);
+  // Ranked: those tied at the best net consensus come first.
+  long tied = 0;
+  while (tied < static_cast<long>(candidates.size()) &&
+         netConsensus(candidates[static_cast<std::size_t>(tied)]) == netConsensus(candidates.front()))
+  {
+    ++tied;
+  }
+  const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (tied >= 2)
+  for (long j = 0; j < tied; ++j)
+  {
+    settleInNearBasin(map, readings, settings, step_xy, step_theta, candidates[static_cast<std::size_t>(j)]);
+  }
+  candidates = rankAndDeduplicate(std::move(candidates), options.uniqueness_distance, options.uniqueness_angle,
+                                  options.max_candidates);
+}
+
+}  // namespace core
+}  // namespace fdml_localization

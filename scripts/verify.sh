@@ -3,7 +3,10 @@
 # random trials over reading geometries on small maps, both engines, noise-free and noisy,
 # checked against the truth and a sampled reference; prints the figures (docs/BENCHMARKS.md).
 #   VERIFY_TRIALS=N VERIFY_MINUTES=M   override the default 10,000 trials or 15 minutes
-#   VERIFY_MAPS="a.poly b.poly"        verify on these polygon maps instead of the small ones
+#   VERIFY_MAPS="a.poly b.poly:0.25"   verify on these polygon maps (each scaled by :SCALE) ...
+#   VERIFY_RANDOM_MAPS=N VERIFY_BUILDINGS=N   ... and on N random 70-gons, N generated 12 x 9 m
+#                                      buildings drawn from the seed, instead of the small ones
+#   VERIFY_SEED=S                      the trials' seed (default 16)
 #   VERIFY_RESOLUTION=N                the engines' resolution (default 64)
 set -euo pipefail
 source "$(dirname "$0")/common.sh"
@@ -14,5 +17,8 @@ map_args=()
 for map in ${VERIFY_MAPS:-}; do
   map_args+=(--map "$map")
 done
+[ -z "${VERIFY_RANDOM_MAPS:-}" ] || map_args+=(--random-maps "$VERIFY_RANDOM_MAPS")
+[ -z "${VERIFY_BUILDINGS:-}" ] || map_args+=(--buildings "$VERIFY_BUILDINGS")
 "$WS/devel/lib/fdml_localization/verify_localization" --trials "${VERIFY_TRIALS:-10000}" \
-  --minutes "${VERIFY_MINUTES:-15}" --resolution "${VERIFY_RESOLUTION:-64}" "${map_args[@]}"
+  --minutes "${VERIFY_MINUTES:-15}" --resolution "${VERIFY_RESOLUTION:-64}" --seed "${VERIFY_SEED:-16}" \
+  "${map_args[@]}"

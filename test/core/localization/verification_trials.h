@@ -61,11 +61,12 @@ inline std::vector<std::shared_ptr<const MapRayCaster>> smallMaps()
   return { test::loadMap("maps/l_room.poly"), test::lRoomMap(), test::loadMap("maps/square_room.poly") };
 }
 
-/// One single-thread localizer of @p engine at resolution 64 per map of smallMaps().
-inline std::vector<std::unique_ptr<Localizer>> smallMapLocalizers(Engine engine)
+/// One single-thread localizer of @p engine at resolution 64 per map of @p maps.
+inline std::vector<std::unique_ptr<Localizer>>
+localizersFor(const std::vector<std::shared_ptr<const MapRayCaster>>& maps, Engine engine)
 {
   std::vector<std::unique_ptr<Localizer>> localizers;
-  for (const auto& map : smallMaps())
+  for (const auto& map : maps)
   {
     LocalizerOptions options;
     options.engine = engine;
@@ -74,6 +75,12 @@ inline std::vector<std::unique_ptr<Localizer>> smallMapLocalizers(Engine engine)
     localizers.push_back(std::make_unique<Localizer>(map, options));
   }
   return localizers;
+}
+
+/// localizersFor() the maps of smallMaps().
+inline std::vector<std::unique_ptr<Localizer>> smallMapLocalizers(Engine engine)
+{
+  return localizersFor(smallMaps(), engine);
 }
 
 inline std::vector<Pose2> trialOffsets(int geometry, int k, std::mt19937_64& rng)

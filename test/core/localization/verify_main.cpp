@@ -2,8 +2,13 @@
 // given time (default 10,000 or 15 minutes), both engines; prints the figures per engine and
 // per geometry and every failure; exits 1 when the truth was missed in a noise-free trial or a
 // certificate was contradicted.
-//   verify_localization [--trials N] [--minutes M] [--seed S] [--resolution N] [--map FILE.poly ...]
-// --map (repeatable) verifies on those polygon maps instead of the three small built-in ones.
+//   verify_localization [--trials N] [--minutes M] [--seed S] [--resolution N] [--map FILE.poly[:SCALE] ...]
+//                       [--random-maps N] [--buildings N]
+// --map (repeatable) verifies on those polygon maps (scaled about the origin by SCALE), --random-maps
+// on N random star-shaped 70-gons (mean radius 2 m, radii 1 to 3 m), --buildings on N generated
+// 12 x 9 m buildings (1.2 m corridors, 3 m rooms, 10 cm walls), both drawn from the seed: maps no
+// test was tuned on. Without any of them, the three small built-in maps.
+#include "generated_maps.h"
 #include "verification_trials.h"
 
 #include "fdml_localization/core/map/map_io.h"
@@ -12,6 +17,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
+#include <stdexcept>
+#include <string>
 
 namespace
 {
@@ -27,8 +34,13 @@ struct Args
   double minutes = 15.0;
   unsigned long seed = 16;
   int resolution = 64;
-  std::vector<std::string> maps;  ///< empty: verification::smallMaps()
+  std::vector<std::string> maps;  ///< FILE.poly[:SCALE]; none of these three: verification::smallMaps()
+  int random_maps = 0;
+  int buildings = 0;
 };
+
+/// Generated maps beside the files: at most this many of each kind.
+constexpr double kMaxGenerated = 100;
 
 bool parse(int argc, char** argv, Args& args)
 {
@@ -61,6 +73,14 @@ bool parse(int argc, char** argv, Args& args)
     else if (std::strcmp(argv[i], "--resolution") == 0 && value >= 16 && value <= 1024)
     {
       args.resolution = static_cast<int>(value);
+    }
+    else if (std::strcmp(argv[i], "--random-maps") == 0 && value <= kMaxGenerated)
+    {
+      args.random_maps = static_cast<int>(value);
+    }
+    else if (std::strcmp(argv[i], "--buildings") == 0 && value <= kMaxGenerated)
+    {
+      args.buildings = static_cast<int>(value);
     }
     else
     {
@@ -101,14 +121,39 @@ void add(const verification::Figures& one, verification::Figures& f)
   f.top1 += one.top1;
   f.seconds += one.seconds;
 }
-/// The maps of --map, or without one the small built-in maps; false (and a message) on a bad file.
-bool loadMaps(const Args& args, std::vector<std::shared_ptr<const MapRayCaster>>& maps)
+/// The map of one --map value, FILE.poly[:SCALE] (SCALE > 0, about the origin).
+fdml_localization::core::PolygonMap mapOf(const std::string& spec)
+{
+  const std::size_t colon = spec.rfind(':');
+  if (colon == std::string::npos)
+  {
+    return fdml_localization::core::loadPolyFile(spec);
+  }
+  char* end = nullptr;
+  const double scale = std::strtod(spec.c_str() + colon + 1, &end);
+  if (end == spec.c_str() + colon + 1 || *end != '\0' || !(scale > 0.0) || scale > 1e6)
+  {
+    throw std::invalid_argument("--map " + spec + ": the scale after ':' must be a number in (0, 1e6]");
+  }
+  return fdml_localization::core::loadPolyFile(spec.substr(0, colon)).scaled(scale);
+}
+
+/// The maps of --map, --random-maps and --buildings, or without any the small built-in maps, with
+/// their names; false (and a message) on a bad file or scale.
+bool loadMaps(const Args& args, std::vector<std::shared_ptr<const MapRayCaster>>& maps, std::vector<std::string>& names)
 {
   try
   {
-    for (const std::string& path : args.maps)
+    for (const std::string& spec : args.maps)
     {
-      maps.push_back(std::make_shared<const MapRayCaster>(fdml_localization::core::loadPolyFile(path)));
+      maps.push_back(std::make_shared<const MapRayCaster>(mapOf(spec)));
+      names.push_back(spec);
+    }
+    for (verification::GeneratedMap& generated :
+         verification::generatedMaps(args.random_maps, args.buildings, args.seed))
+    {
+      maps.push_back(std::move(generated.map));
+      names.push_back(std::move(generated.name));
     }
   }
   catch (const std::exception& e)
@@ -119,18 +164,20 @@ bool loadMaps(const Args& args, std::vector<std::shared_ptr<const MapRayCaster>>
   if (maps.empty())
   {
     maps = verification::smallMaps();
+    names = { "maps/l_room.poly", "L-room 8 x 6 m (lRoomMap())", "maps/square_room.poly" };
   }
   return true;
 }
 /// Prints the figures per engine and per geometry.
-void report(const Args& args, long trial_count, double seconds, const verification::Figures (&total)[2],
+void report(const Args& args, const std::vector<std::string>& names, long trial_count, double seconds,
+            const verification::Figures (&total)[2],
             const verification::Figures (&by_geometry)[2][verification::kGeometries])
 {
-  std::printf("\n%ld trials per engine in %.0f s (seed %lu, resolution %d, maps %s)\n", trial_count, seconds, args.seed,
-              args.resolution, args.maps.empty() ? "l_room.poly, L-room 8 x 6 m, square_room.poly" : "given");
-  for (std::size_t m = 0; m < args.maps.size(); ++m)
+  std::printf("\n%ld trials per engine in %.0f s (seed %lu, resolution %d)\n", trial_count, seconds, args.seed,
+              args.resolution);
+  for (std::size_t m = 0; m < names.size(); ++m)
   {
-    std::printf("map %zu: %s\n", m, args.maps[m].c_str());
+    std::printf("map %zu: %s\n", m, names[m].c_str());
   }
   for (int e = 0; e < 2; ++e)
   {
@@ -149,11 +196,12 @@ int main(int argc, char** argv)
   if (!parse(argc, argv, args))
   {
     std::cerr << "usage: verify_localization [--trials N] [--minutes M] [--seed S] [--resolution N] "
-                 "[--map FILE.poly ...]\n";
+                 "[--map FILE.poly[:SCALE] ...] [--random-maps N] [--buildings N]\n";
     return 2;
   }
   std::vector<std::shared_ptr<const MapRayCaster>> maps;
-  if (!loadMaps(args, maps))
+  std::vector<std::string> names;
+  if (!loadMaps(args, maps, names))
   {
     return 2;
   }
@@ -190,8 +238,8 @@ int main(int argc, char** argv)
       }
     }
   }
-  report(args, trial_count, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), total,
-         by_geometry);
+  report(args, names, trial_count, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+         total, by_geometry);
   const bool ok = total[0].missed + total[1].missed + total[0].contradicted + total[1].contradicted == 0;
   return ok ? 0 : 1;
 }

@@ -248,14 +248,20 @@ TEST(LocalizerNode, ContinuousModeSolvesEveryBatchAndPublishesThePose)
   expectWithinTolerance(fromPoseMsg(result.candidates.front().pose), scene.baseInMap(last),
                         "continuous best candidate");
 
-  // ~pose: the best, carried forward to the newest reading, with a positive covariance.
+  // ~pose: the best, carried forward to the newest reading, with a positive covariance. Its
+  // queue holds one message: on a loaded machine the worker can publish two batches back to back
+  // and the first pose is replaced before it is sent (a make test run once missed the pose of the
+  // result's own batch), so the pose of this batch or a later one, checked at its own reading.
+  ASSERT_TRUE(result.unambiguous) << "a tracking update that is not clearly supported publishes no ~pose";
   geometry_msgs::PoseWithCovarianceStamped pose;
   ASSERT_TRUE(poses.waitFor(
       [&result](const geometry_msgs::PoseWithCovarianceStamped& msg) {
-        return msg.header.stamp == result.header.stamp;
+        return msg.header.stamp >= result.header.stamp;
       },
       10.0, &pose));
-  expectWithinTolerance(fromPoseMsg(pose.pose.pose), scene.baseInMap(last), "~pose");
+  const int pose_index = publisher.indexOf(pose.header.stamp);
+  ASSERT_GE(pose_index, last);
+  expectWithinTolerance(fromPoseMsg(pose.pose.pose), scene.baseInMap(pose_index), "~pose");
   EXPECT_GT(pose.pose.covariance[0], 0.0);
   EXPECT_GT(pose.pose.covariance[7], 0.0);
   EXPECT_GT(pose.pose.covariance[35], 0.0);

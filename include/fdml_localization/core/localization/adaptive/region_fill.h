@@ -27,6 +27,9 @@ namespace core
  *        candidates miss. Open: the @p leaves reaching the best candidate's net consensus whose
  *        box holds no candidate's pose (within the uniqueness margins); a leaf whose centre lies
  *        within 3 sigma of a candidate's covariance grown by the leaf's size is on its continuum.
+ *        Open too: a leaf within the margins of a candidate at that consensus, short of exact (RMS
+ *        1 um or more) that does not hold its pose: its own place, searched first (30,000 box
+ *        tests), a better place there replacing it.
  *        Those whose bound exceeds the consensus are screened first (screenLeaf(), three
  *        halvings, 100,000 box tests in all), those at it probed (probeLeaf(), another 100,000): a
  *        leaf with no sub-box reaching its bound has its bound lowered by one, the others are

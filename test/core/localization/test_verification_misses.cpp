@@ -268,6 +268,21 @@ const BundledMiss kBundledMapMisses[] = {
   { "turning map 2 k 5 exact truth (30.200420693458543, 6.8371734082116813, 1.4644924455953543)", 64, Engine::Voxel },
 };
 
+/// The noise-free trial of @p label on @p maps, localized by @p engine at @p resolution: every
+/// failure of checkNoiseFree() (the truth missed, the best candidate inaccurate) added.
+void expectTruthFound(const std::vector<std::shared_ptr<const MapRayCaster>>& maps, const std::string& label,
+                      Engine engine, int resolution)
+{
+  const verification::Trial trial = trialFrom(label, maps);
+  Localizer localizer(maps[static_cast<std::size_t>(trial.map)], verification::trialOptions(engine, resolution));
+  verification::Figures figures;
+  verification::checkNoiseFree(localizer, trial, localizer.localize(trial.readings), label, figures);
+  for (const std::string& failure : figures.failures)
+  {
+    ADD_FAILURE() << toString(engine) << ", resolution " << resolution << ": " << failure;
+  }
+}
+
 TEST(PastMissesOnBundledMaps, BothEnginesSearchEveryRegionReachingTheConsensus)
 {
   std::vector<std::shared_ptr<const MapRayCaster>> maps;
@@ -277,18 +292,7 @@ TEST(PastMissesOnBundledMaps, BothEnginesSearchEveryRegionReachingTheConsensus)
   }
   for (const BundledMiss& miss : kBundledMapMisses)
   {
-    const verification::Trial trial = trialFrom(miss.label, maps);
-    LocalizerOptions options;
-    options.engine = miss.engine;
-    options.resolution = miss.resolution;
-    options.threads = 1;
-    Localizer localizer(maps[static_cast<std::size_t>(trial.map)], options);
-    verification::Figures figures;
-    verification::checkNoiseFree(localizer, trial, localizer.localize(trial.readings), miss.label, figures);
-    for (const std::string& failure : figures.failures)
-    {
-      ADD_FAILURE() << toString(miss.engine) << ", resolution " << miss.resolution << ": " << failure;
-    }
+    expectTruthFound(maps, miss.label, miss.engine, miss.resolution);
   }
 }
 
@@ -304,20 +308,9 @@ TEST(PastMissesOnGeneratedMaps, TheOwnPlaceOfABestCandidateIsSearched)
       randomPolygon(70, 2.0, 0.5, 312000)) };
   const std::string label = "driving map 0 k 5 exact truth (-0.20409421871068378, -0.30737713061474903, "
                             "0.19741754104986731)";
-  const verification::Trial trial = trialFrom(label, maps);
   for (const Engine engine : { Engine::Voxel, Engine::Adaptive })
   {
-    LocalizerOptions options;
-    options.engine = engine;
-    options.resolution = 64;
-    options.threads = 1;
-    Localizer localizer(maps.front(), options);
-    verification::Figures figures;
-    verification::checkNoiseFree(localizer, trial, localizer.localize(trial.readings), label, figures);
-    for (const std::string& failure : figures.failures)
-    {
-      ADD_FAILURE() << toString(engine) << ": " << failure;
-    }
+    expectTruthFound(maps, label, engine, 64);
   }
 }
 

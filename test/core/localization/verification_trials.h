@@ -61,18 +61,24 @@ inline std::vector<std::shared_ptr<const MapRayCaster>> smallMaps()
   return { test::loadMap("maps/l_room.poly"), test::lRoomMap(), test::loadMap("maps/square_room.poly") };
 }
 
-/// One single-thread localizer of @p engine at resolution 64 per map of @p maps.
+/// The options of a verification trial: @p engine at @p resolution, one thread.
+inline LocalizerOptions trialOptions(Engine engine, int resolution = 64)
+{
+  LocalizerOptions options;
+  options.engine = engine;
+  options.resolution = resolution;
+  options.threads = 1;
+  return options;
+}
+
+/// One localizer with trialOptions() per map of @p maps.
 inline std::vector<std::unique_ptr<Localizer>>
-localizersFor(const std::vector<std::shared_ptr<const MapRayCaster>>& maps, Engine engine)
+localizersFor(const std::vector<std::shared_ptr<const MapRayCaster>>& maps, Engine engine, int resolution = 64)
 {
   std::vector<std::unique_ptr<Localizer>> localizers;
   for (const auto& map : maps)
   {
-    LocalizerOptions options;
-    options.engine = engine;
-    options.resolution = 64;
-    options.threads = 1;
-    localizers.push_back(std::make_unique<Localizer>(map, options));
+    localizers.push_back(std::make_unique<Localizer>(map, trialOptions(engine, resolution)));
   }
   return localizers;
 }

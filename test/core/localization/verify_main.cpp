@@ -24,7 +24,6 @@ namespace
 {
 using fdml_localization::core::Engine;
 using fdml_localization::core::Localizer;
-using fdml_localization::core::LocalizerOptions;
 using fdml_localization::core::MapRayCaster;
 namespace verification = fdml_localization::core::verification;
 
@@ -98,14 +97,6 @@ void print(const char* name, const verification::Figures& f)
               name, f.trials, f.noise_free, f.undetermined, f.missed, f.inaccurate, f.contradicted, f.far_optima,
               f.trials ? 100.0 * f.complete / f.trials : 0.0, f.trials ? 100.0 * f.top1 / f.trials : 0.0,
               f.trials ? 1000.0 * f.seconds / f.trials : 0.0);
-}
-LocalizerOptions options(Engine engine, int resolution)
-{
-  LocalizerOptions o;
-  o.engine = engine;
-  o.resolution = resolution;
-  o.threads = 1;
-  return o;
 }
 
 void add(const verification::Figures& one, verification::Figures& f)
@@ -205,15 +196,10 @@ int main(int argc, char** argv)
   {
     return 2;
   }
-  std::vector<std::unique_ptr<Localizer>> localizers[2];
-  for (int e = 0; e < 2; ++e)
-  {
-    for (const auto& map : maps)
-    {
-      localizers[e].push_back(
-          std::make_unique<Localizer>(map, options(e == 0 ? Engine::Voxel : Engine::Adaptive, args.resolution)));
-    }
-  }
+  const std::vector<std::unique_ptr<Localizer>> localizers[2] = {
+    verification::localizersFor(maps, Engine::Voxel, args.resolution),
+    verification::localizersFor(maps, Engine::Adaptive, args.resolution)
+  };
   std::mt19937_64 rng(args.seed);
   verification::Figures total[2];
   verification::Figures by_geometry[2][verification::kGeometries];

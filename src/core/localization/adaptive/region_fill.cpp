@@ -137,7 +137,7 @@ std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<Leaf
     if (rival != nullptr)
     {
       o.rival = *rival;
-      o.centre.inliers = -1;  // verified when searched: such leaves wait for pass 1
+      o.centre.inliers = -1;  // verified when searched: own places first, continua in pass 1
     }
     else
     {

@@ -6,7 +6,7 @@ set -uo pipefail
 export WS="${WS_ASAN:-$(cd "$(dirname "$0")/.." && pwd)/ws-asan}"
 source "$(dirname "$0")/common.sh"
 # ASAN_TARGETS="test_core_map test_fuzz" narrows the run (e.g. to what a change touched).
-read -r -a TARGETS <<<"${ASAN_TARGETS:-test_core_geometry test_core_map test_core_localization test_core_voxel test_core_tracking test_simulation test_tools test_ros_units test_fuzz}"
+read -r -a TARGETS <<<"${ASAN_TARGETS:-test_core_geometry test_core_util test_core_map test_core_localization test_core_voxel test_core_tracking test_simulation test_tools test_ros_units test_fuzz}"
 
 if ! catkin_build -DFDML_SANITIZE=ON "${TARGETS[@]}"; then
   echo "asan build failed"

@@ -70,22 +70,6 @@ std::vector<int> parseIntList(const std::string& text, const std::string& flag)
   return out;
 }
 
-/// Splits "BASE[:SCALE]" on its last ':' when what follows is a number (> 0).
-std::pair<std::string, double> splitScale(const std::string& text, const std::string& flag)
-{
-  const std::size_t colon = text.rfind(':');
-  if (colon == std::string::npos)
-  {
-    return { text, 1.0 };
-  }
-  const double scale = core::parseNumber(text.substr(colon + 1), flag + " scale");
-  if (!(scale > 0.0))
-  {
-    throw UsageError(flag + ": scale " + text.substr(colon + 1) + " must be > 0");
-  }
-  return { text.substr(0, colon), scale };
-}
-
 std::string scaleSuffix(double scale)
 {
   if (scale == 1.0)
@@ -99,7 +83,7 @@ std::string scaleSuffix(double scale)
 
 core::BenchScene mapScene(const std::string& spec)
 {
-  const auto [path, scale] = splitScale(spec, "--map");
+  const auto [path, scale] = core::splitScale(spec, "--map");
   const std::size_t slash = path.find_last_of('/');
   std::string stem = slash == std::string::npos ? path : path.substr(slash + 1);
   const std::size_t dot = stem.rfind('.');
@@ -117,7 +101,7 @@ core::BenchScene mapScene(const std::string& spec)
 
 core::BenchScene randomScene(const std::string& spec, std::uint64_t seed)
 {
-  const auto [count, scale] = splitScale(spec, "--random");
+  const auto [count, scale] = core::splitScale(spec, "--random");
   const int vertices = core::parseInteger(count, "--random");
   if (vertices < 3 || vertices > 100000)
   {

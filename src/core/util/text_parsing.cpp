@@ -58,5 +58,21 @@ void parsePoint(const std::string& text, const std::string& what, double& x, dou
   y = parseNumber(text.substr(comma + 1), what);
 }
 
+std::pair<std::string, double> splitScale(const std::string& text, const std::string& what)
+{
+  const std::size_t colon = text.rfind(':');
+  if (colon == std::string::npos)
+  {
+    return { text, 1.0 };
+  }
+  const std::string scale_text = text.substr(colon + 1);
+  const double scale = parseNumber(scale_text, what + " scale");
+  if (!(scale > 0.0) || scale > 1e6)
+  {
+    throw std::invalid_argument(what + ": scale " + scale_text + " must be in (0, 1e6]");
+  }
+  return { text.substr(0, colon), scale };
+}
+
 }  // namespace core
 }  // namespace fdml_localization

@@ -12,6 +12,7 @@
 #include "verification_trials.h"
 
 #include "fdml_localization/core/map/map_io.h"
+#include "fdml_localization/core/util/text_parsing.h"
 
 #include <chrono>
 #include <cstdlib>
@@ -112,21 +113,11 @@ void add(const verification::Figures& one, verification::Figures& f)
   f.top1 += one.top1;
   f.seconds += one.seconds;
 }
-/// The map of one --map value, FILE.poly[:SCALE] (SCALE > 0, about the origin).
+/// The map of one --map value, FILE.poly[:SCALE] (SCALE in (0, 1e6], about the origin).
 fdml_localization::core::PolygonMap mapOf(const std::string& spec)
 {
-  const std::size_t colon = spec.rfind(':');
-  if (colon == std::string::npos)
-  {
-    return fdml_localization::core::loadPolyFile(spec);
-  }
-  char* end = nullptr;
-  const double scale = std::strtod(spec.c_str() + colon + 1, &end);
-  if (end == spec.c_str() + colon + 1 || *end != '\0' || !(scale > 0.0) || scale > 1e6)
-  {
-    throw std::invalid_argument("--map " + spec + ": the scale after ':' must be a number in (0, 1e6]");
-  }
-  return fdml_localization::core::loadPolyFile(spec.substr(0, colon)).scaled(scale);
+  const auto [path, scale] = fdml_localization::core::splitScale(spec, "--map " + spec);
+  return fdml_localization::core::loadPolyFile(path).scaled(scale);
 }
 
 /// The maps of --map, --random-maps and --buildings, or without any the small built-in maps, with

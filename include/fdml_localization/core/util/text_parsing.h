@@ -6,6 +6,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 
 namespace fdml_localization
 {
@@ -27,6 +28,13 @@ int parseInteger(const std::string& text, const std::string& what);
 
 /// Parses "X,Y" (two finite numbers) into @p x and @p y. @throws std::invalid_argument naming @p what.
 void parsePoint(const std::string& text, const std::string& what, double& x, double& y);
+
+/**
+ * @brief Splits "BASE[:SCALE]" (a map file or a generated map, and a scale about the origin) on
+ *        its last ':'; without one the scale is 1.
+ * @throws std::invalid_argument naming @p what when SCALE is not a number in (0, 1e6]
+ */
+std::pair<std::string, double> splitScale(const std::string& text, const std::string& what);
 
 }  // namespace core
 }  // namespace fdml_localization

@@ -223,12 +223,7 @@ constexpr double kEndGain = 0.5;
 Candidate polishedFrom(const MapRayCaster& map, const std::vector<Reading>& readings,
                        const RefinementSettings& settings, const Candidate& candidate, const Pose2& start)
 {
-  std::vector<bool> use = candidate.inlier_mask;
-  for (std::size_t i = 0; i < readings.size(); ++i)
-  {
-    use[i] = use[i] && std::isfinite(readings[i].range);
-  }
-  const PolishOutcome polished = polishPose(map, start, readings, use, settings.agreement_tolerance,
+  const PolishOutcome polished = polishPose(map, start, readings, candidate.inlier_mask, settings.agreement_tolerance,
                                             settings.max_iterations, settings.noise_sigma);
   Candidate c = candidateFrom(polished.pose, evaluatePose(map, polished.pose, readings, settings.agreement_tolerance));
   c.covariance = polished.covariance;

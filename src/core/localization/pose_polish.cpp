@@ -125,6 +125,46 @@ ResidualRow readingRow(const MapRayCaster& map, const Pose2& q, const Rotation& 
   return reading.half_angle > 0.0 ? coneRow(map, q, rq, reading, hint) : rayRow(map, q, rq, reading, mount);
 }
 
+/// The one-sided row of a no-return reading (free up to its max range): the range the map
+/// gives short of max_range (r < 0) where a wall lies within it, else inactive (not valid).
+ResidualRow noReturnRow(const MapRayCaster& map, const Pose2& q, const Rotation& rq, const Reading& reading,
+                        const Rotation& mount, Vec2& hint)
+{
+  if (!(reading.max_range < kInf))
+  {
+    return ResidualRow();
+  }
+  Reading bound = reading;
+  bound.range = reading.max_range;
+  ResidualRow row = readingRow(map, q, rq, bound, mount, hint);
+  row.valid = row.valid && row.r < 0.0;
+  return row;
+}
+
+/// Adds @p row's cost (Cauchy loss of @p scale [m], 0 = squares) and gradient to @p sys; its
+/// information too when @p informs (a range; not a no-return's one-sided bound).
+void addRow(System& sys, const ResidualRow& row, double scale, bool informs)
+{
+  double w = 1.0;
+  if (scale > 0.0)
+  {
+    const double z = (row.r / scale) * (row.r / scale);
+    sys.cost += scale * scale * std::log1p(z);
+    w = 1.0 / (1.0 + z);
+  }
+  else
+  {
+    sys.cost += row.r * row.r;
+  }
+  sys.h += w * row.jacobian.transpose() * row.jacobian;
+  sys.g += w * row.jacobian.transpose() * row.r;
+  if (informs)
+  {
+    sys.jtj += row.jacobian.transpose() * row.jacobian;
+    sys.sum_sq += row.r * row.r;
+  }
+}
+
 /// The normal equations at @p q; @p hints: each cone reading's last hit point (see coneRow).
 System buildSystem(const MapRayCaster& map, const Pose2& q, const std::vector<Reading>& readings,
                    const std::vector<Rotation>& mounts, const std::vector<bool>& use, double scale,
@@ -134,8 +174,17 @@ System buildSystem(const MapRayCaster& map, const Pose2& q, const std::vector<Re
   const Rotation rq(q.theta);
   for (std::size_t i = 0; i < readings.size(); ++i)
   {
-    if (!use[i] || !std::isfinite(readings[i].range))
+    if (!use[i])
     {
+      continue;
+    }
+    if (!std::isfinite(readings[i].range))
+    {
+      const ResidualRow bound = noReturnRow(map, q, rq, readings[i], mounts[i], hints[i]);
+      if (bound.valid)
+      {
+        addRow(sys, bound, scale, false);
+      }
       continue;
     }
     const ResidualRow row = readingRow(map, q, rq, readings[i], mounts[i], hints[i]);
@@ -146,21 +195,7 @@ System buildSystem(const MapRayCaster& map, const Pose2& q, const std::vector<Re
       sys.cost += scale > 0.0 ? scale * scale * std::log1p((p / scale) * (p / scale)) : p * p;
       continue;
     }
-    double w = 1.0;
-    if (scale > 0.0)
-    {
-      const double z = (row.r / scale) * (row.r / scale);
-      sys.cost += scale * scale * std::log1p(z);
-      w = 1.0 / (1.0 + z);
-    }
-    else
-    {
-      sys.cost += row.r * row.r;
-    }
-    sys.h += w * row.jacobian.transpose() * row.jacobian;
-    sys.g += w * row.jacobian.transpose() * row.r;
-    sys.jtj += row.jacobian.transpose() * row.jacobian;
-    sys.sum_sq += row.r * row.r;
+    addRow(sys, row, scale, true);
   }
   return sys;
 }

@@ -37,8 +37,8 @@ bool Refiner::consider(const PolishOutcome& polished, bool pull_back)
   return true;
 }
 
-/// The polish does not see no-return readings (nor walls its rays newly hit): a step from the
-/// best pose that contradicts more readings is tried again at fractions of its length.
+/// The polish does not see walls its rays newly hit (nor no-returns outside its bounds): a step
+/// from the best pose that contradicts more readings is tried again at fractions of its length.
 bool Refiner::pullBack(const PolishOutcome& polished)
 {
   const Pose2 from = best_pose_;
@@ -55,9 +55,17 @@ bool Refiner::pullBack(const PolishOutcome& polished)
   return false;
 }
 
+/// Every polish also keeps clear the no-returns the hypothesis or the best pose counts as agreeing
+/// (polishPose()'s one-sided bounds): with 2 finite readings of 10 and 8 short no-returns, the
+/// polish otherwise slides along the finite readings' continuum past the walls they exclude.
 PolishOutcome Refiner::polish(const Pose2& start, const std::vector<bool>& use, double scale) const
 {
-  return polishPose(map_, start, readings_, use, scale, settings_.max_iterations, settings_.noise_sigma,
+  std::vector<bool> bounded = use;
+  for (std::size_t i = 0; i < readings_.size(); ++i)
+  {
+    bounded[i] = bounded[i] || (!std::isfinite(readings_[i].range) && (hypothesis_[i] || best_.inlier_mask[i]));
+  }
+  return polishPose(map_, start, readings_, bounded, scale, settings_.max_iterations, settings_.noise_sigma,
                     settings_.prior);
 }
 

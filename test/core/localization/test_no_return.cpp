@@ -4,6 +4,7 @@
 // corridor can.
 #include "fdml_localization/core/localization/localizer.h"
 #include "fdml_localization/core/localization/no_return.h"
+#include "fdml_localization/core/localization/robust_search.h"
 
 #include <gtest/gtest.h>
 
@@ -184,4 +185,31 @@ TEST(NoReturn, OnlyNoReturnsGiveAnUndeterminedPoseNeverACertainOne)
       EXPECT_GT(std::sqrt(c.covariance(2, 2)), 1.0) << core::toString(engine) << at;
     }
   }
+}
+
+TEST(NoReturnPolish, KeepsClearOfTheWallsANoReturnExcludes)
+{
+  // A 4 m square room; two returns, left and right (2 m each), fix y and the heading and leave
+  // x free; a no-return ahead with a 1.5 m max range keeps x <= 2.5. From x = 3.5 (the wall
+  // 0.5 m ahead) the polish moves x only through the no-return's one-sided bound.
+  const core::MapRayCaster room(core::PolygonMap::fromRings({ { { 0, 0 }, { 4, 0 }, { 4, 4 }, { 0, 4 } } }));
+  std::vector<core::Reading> readings(3);
+  readings[0].offset = core::Pose2(0.0, 0.0, 0.5 * core::kPi);
+  readings[1].offset = core::Pose2(0.0, 0.0, -0.5 * core::kPi);
+  readings[0].range = readings[1].range = 2.0;
+  readings[2].range = core::kInf;
+  readings[2].max_range = 1.5;
+  const core::Pose2 start(3.5, 1.8, 0.05);
+  const core::PolishOutcome bounded = core::polishPose(room, start, readings, { true, true, true }, 0.0, 50, 0.01);
+  EXPECT_NEAR(bounded.pose.x, 2.5, 1e-3);  // moved only as far as the bound needs
+  EXPECT_NEAR(bounded.pose.y, 2.0, 1e-6);
+  EXPECT_NEAR(bounded.pose.theta, 0.0, 1e-6);
+  const core::PoseEvaluation eval = core::evaluatePose(room, bounded.pose, readings, 0.01);
+  EXPECT_EQ(eval.inliers, 3);
+  EXPECT_EQ(eval.contradicted, 0);
+  EXPECT_GT(bounded.covariance(0, 0), 1.0);  // a bound adds nothing to the covariance: x stays free
+  // Not selected, the no-return does not move the pose.
+  const core::PolishOutcome free = core::polishPose(room, start, readings, { true, true, false }, 0.0, 50, 0.01);
+  EXPECT_NEAR(free.pose.x, 3.5, 1e-6);
+  EXPECT_EQ(core::evaluatePose(room, free.pose, readings, 0.01).contradicted, 1);
 }

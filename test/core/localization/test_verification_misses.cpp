@@ -6,6 +6,7 @@
 // k' where the truth's seed fell short of the level another place reached first; a tied optimum
 // closer than the uniqueness distance; a large region with few finite readings; a truth the
 // seeding's sample test missed in a large conservative region.
+#include "generated_maps.h"
 #include "verification_trials.h"
 
 #include "fdml_localization/simulation/map_generators.h"
@@ -308,6 +309,28 @@ TEST(PastMissesOnGeneratedMaps, TheOwnPlaceOfABestCandidateIsSearched)
       randomPolygon(70, 2.0, 0.5, 312000)) };
   const std::string label = "driving map 0 k 5 exact truth (-0.20409421871068378, -0.30737713061474903, "
                             "0.19741754104986731)";
+  for (const Engine engine : { Engine::Voxel, Engine::Adaptive })
+  {
+    expectTruthFound(maps, label, engine, 64);
+  }
+}
+
+// Seventeenth round, a generated building (`verify_localization --seed 501 --random-maps 2
+// --buildings 2`, its map 2): turning in place, 2 of 10 readings return and 8 no-returns of
+// 1.71 m leave a continuum of poses explaining all 10, the truth's 2.5 cm from a wall one
+// no-return excludes. The adaptive engine's polish slid along the two returns' continuum into
+// walls the no-returns exclude (9 explained, 1 contradicted, everywhere), and the fill's budget
+// ran out among 8,164 leaves reaching 10. The polish keeps clear of them now (a no-return it
+// counts is a one-sided bound).
+TEST(PastMissesOnGeneratedMaps, ThePolishKeepsClearOfTheWallsNoReturnsExclude)
+{
+  std::vector<std::shared_ptr<const MapRayCaster>> maps;
+  for (verification::GeneratedMap& generated : verification::generatedMaps(0, 1, 501))
+  {
+    maps.push_back(std::move(generated.map));
+  }
+  const std::string label = "no-return map 0 k 10 exact truth (8.4656908668182442, 1.7111956736015532, "
+                            "-2.7183979719256448) max range 1.7116808934350787";
   for (const Engine engine : { Engine::Voxel, Engine::Adaptive })
   {
     expectTruthFound(maps, label, engine, 64);

@@ -88,7 +88,10 @@ struct PosePrior
  *        @p start: Levenberg-Marquardt on (x, y, theta) with the analytic derivative of the exact
  *        ray cast (the hit edge's normal), or of the exact cone cast for a cone reading
  *        (coneRangeDerivative()). A ray that leaves free space or misses costs a
- *        constant penalty, so the polish does not walk through walls.
+ *        constant penalty, so the polish does not walk through walls. A no-return reading
+ *        selected (range +inf, a finite max_range) is a one-sided bound: where the map has a wall
+ *        within max_range, the range short of it is a residual (same loss); it adds nothing to
+ *        the covariance.
  * @param robust_scale Cauchy loss scale [m]; 0 = plain least squares
  * @param noise_sigma lower bound on the residual standard deviation used for the covariance [m]
  * @param prior a prior on the pose (PosePrior); the covariance returned is still the readings'

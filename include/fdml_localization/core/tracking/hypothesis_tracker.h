@@ -72,8 +72,8 @@ struct TrackerOptions
   /// covariance growing), none of them a conflict, >= 0
   int tolerated_misses = 20;
   /// A miss in which at least this many readings contradict every refined pose of the box
-  /// (longer than the map allows: no unknown obstacle explains them) is a conflict: the
-  /// hypothesis is not published until its next fix. >= 1
+  /// (longer than the map allows: no unknown obstacle explains them), or a fix contradicting this
+  /// many, is a conflict: the hypothesis is not published until a fix without one. >= 1
   int conflict_readings = 2;
   double publish_max_xy = 0.1;       ///< ... and 3 sigma of its position is at most this [m], > 0
   double publish_max_theta = 0.087;  ///< ... and 3 sigma of its heading at most this [rad], > 0
@@ -145,7 +145,7 @@ struct Hypothesis
   double turned = 0.0;      ///< odometry rotation since the last fix [rad]
   double support = 0.0;     ///< decayed sum of net consensus / k
   int misses = 0;           ///< updates in a row without a fix
-  bool conflicted = false;  ///< the last update was a miss in conflict (TrackerOptions::conflict_readings)
+  bool conflicted = false;  ///< the last update was in conflict (TrackerOptions::conflict_readings)
   /// Of the base's pose map_to_odom (+) the tracker's last reference (x, y, theta) [m^2, rad^2],
   /// counting of each fix only what no one direction's readings fix alone
   /// (LocalSolveOutcome::direction_loss): a person in front of the one sensor that fixes a

@@ -9,8 +9,6 @@
 #include "generated_maps.h"
 #include "verification_trials.h"
 
-#include "fdml_localization/simulation/map_generators.h"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -284,6 +282,21 @@ void expectTruthFound(const std::vector<std::shared_ptr<const MapRayCaster>>& ma
   }
 }
 
+/// expectTruthFound() for both engines at resolution 64 on the maps
+/// verification::generatedMaps(@p random_maps, @p buildings, @p seed) draws (verify_localization's).
+void expectTruthFoundOnGeneratedMaps(int random_maps, int buildings, std::uint64_t seed, const std::string& label)
+{
+  std::vector<std::shared_ptr<const MapRayCaster>> maps;
+  for (verification::GeneratedMap& generated : verification::generatedMaps(random_maps, buildings, seed))
+  {
+    maps.push_back(std::move(generated.map));
+  }
+  for (const Engine engine : { Engine::Voxel, Engine::Adaptive })
+  {
+    expectTruthFound(maps, label, engine, 64);
+  }
+}
+
 TEST(PastMissesOnBundledMaps, BothEnginesSearchEveryRegionReachingTheConsensus)
 {
   std::vector<std::shared_ptr<const MapRayCaster>> maps;
@@ -305,14 +318,9 @@ TEST(PastMissesOnBundledMaps, BothEnginesSearchEveryRegionReachingTheConsensus)
 // the paper's floor plan (a basin 1.15 cm from the truth) has its own test (test_pose_extent.cpp).
 TEST(PastMissesOnGeneratedMaps, TheOwnPlaceOfABestCandidateIsSearched)
 {
-  const std::vector<std::shared_ptr<const MapRayCaster>> maps{ std::make_shared<const MapRayCaster>(
-      randomPolygon(70, 2.0, 0.5, 312000)) };
-  const std::string label = "driving map 0 k 5 exact truth (-0.20409421871068378, -0.30737713061474903, "
-                            "0.19741754104986731)";
-  for (const Engine engine : { Engine::Voxel, Engine::Adaptive })
-  {
-    expectTruthFound(maps, label, engine, 64);
-  }
+  expectTruthFoundOnGeneratedMaps(1, 0, 312,
+                                  "driving map 0 k 5 exact truth (-0.20409421871068378, -0.30737713061474903, "
+                                  "0.19741754104986731)");
 }
 
 // Seventeenth round, a generated building (`verify_localization --seed 501 --random-maps 2
@@ -324,17 +332,9 @@ TEST(PastMissesOnGeneratedMaps, TheOwnPlaceOfABestCandidateIsSearched)
 // counts is a one-sided bound).
 TEST(PastMissesOnGeneratedMaps, ThePolishKeepsClearOfTheWallsNoReturnsExclude)
 {
-  std::vector<std::shared_ptr<const MapRayCaster>> maps;
-  for (verification::GeneratedMap& generated : verification::generatedMaps(0, 1, 501))
-  {
-    maps.push_back(std::move(generated.map));
-  }
-  const std::string label = "no-return map 0 k 10 exact truth (8.4656908668182442, 1.7111956736015532, "
-                            "-2.7183979719256448) max range 1.7116808934350787";
-  for (const Engine engine : { Engine::Voxel, Engine::Adaptive })
-  {
-    expectTruthFound(maps, label, engine, 64);
-  }
+  expectTruthFoundOnGeneratedMaps(0, 1, 501,
+                                  "no-return map 0 k 10 exact truth (8.4656908668182442, 1.7111956736015532, "
+                                  "-2.7183979719256448) max range 1.7116808934350787");
 }
 
 // Seventeenth round, a generated random 70-gon (`verify_localization --seed 510 --random-maps 3
@@ -344,18 +344,10 @@ TEST(PastMissesOnGeneratedMaps, ThePolishKeepsClearOfTheWallsNoReturnsExclude)
 // truth's 0. Probes now spend as many reading tests as 100,000 box tests of 16 readings.
 TEST(PastMissesOnGeneratedMaps, FewReadingsProbeMoreLeaves)
 {
-  std::vector<std::shared_ptr<const MapRayCaster>> maps;
-  for (verification::GeneratedMap& generated : verification::generatedMaps(2, 0, 510))
-  {
-    maps.push_back(std::move(generated.map));
-  }
-  const std::string label = "random map 1 k 4 exact truth (0.77699579633644955, 1.0751764657102689, "
-                            "2.5522632244101686) headings -0.017603549990038658 2.726527156001576 "
-                            "-1.6403165907458692 -1.6586703756329839";
-  for (const Engine engine : { Engine::Voxel, Engine::Adaptive })
-  {
-    expectTruthFound(maps, label, engine, 64);
-  }
+  expectTruthFoundOnGeneratedMaps(2, 0, 510,
+                                  "random map 1 k 4 exact truth (0.77699579633644955, 1.0751764657102689, "
+                                  "2.5522632244101686) headings -0.017603549990038658 2.726527156001576 "
+                                  "-1.6403165907458692 -1.6586703756329839");
 }
 
 INSTANTIATE_TEST_SUITE_P(Engines, PastMisses, ::testing::Values(Engine::Voxel, Engine::Adaptive),

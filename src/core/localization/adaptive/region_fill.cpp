@@ -71,8 +71,8 @@ struct OpenLeaf
 /// verifications and refinements of a leaf's search, and most such leaves hold no place (in a
 /// corridor with 13 short no-returns of 16 readings, 305 of 5,251 keep a sub-box 7.8 cm wide).
 /// Leaves at the target are probed instead (probeLeaf(), in their spread order while
-/// kProbeBoxTests or kProbeReadingTests last): a screen costs a quarter more time where readings are mostly no-returns.
-/// In a floor plan of half-metre corridors, 2,392 of 3,879 leaves held no sub-box reaching the
+/// kProbeBoxTests or kProbeReadingTests last): a screen costs a quarter more time where readings
+/// are mostly no-returns. In a floor plan of half-metre corridors, 2,392 of 3,879 leaves held no sub-box reaching the
 /// target, and the truth's leaf, its centre explaining none of 6 readings, ranked 29th in its
 /// region and was never searched; probed, its centre explains 6 and it ranks first.
 void screenOpenLeaves(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,

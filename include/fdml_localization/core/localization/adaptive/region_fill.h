@@ -32,9 +32,9 @@ namespace core
  *        tests), a better place there replacing it.
  *        Those whose bound exceeds the consensus are screened first (screenLeaf(), three
  *        halvings, 100,000 box tests in all), those at it probed (probeLeaf(), another 100,000, or
- *        1,600,000 / k where fewer than 16 readings make box tests cheaper): a
- *        leaf with no sub-box reaching its bound has its bound lowered by one, the others are
- *        ranked by their best (probed: first) sub-box centre where better than theirs. Searched
+ *        1,600,000 / k where fewer than 16 readings make box tests cheaper): a leaf with no
+ *        sub-box reaching its bound has its bound lowered by one, the others are ranked by their
+ *        best (probed: first) sub-box centre where better than theirs. Searched
  *        first the leaves whose bound exceeds the consensus (highest first; a place
  *        there raises it), then round robin over their connected regions (26 neighbours,
  *        @p theta_cells heading cells around the circle: every region's best leaf by its centre,

@@ -145,10 +145,16 @@ inline Pose2 trialTruth(const MapRayCaster& map, int geometry, const std::vector
   }
 }
 
-inline Trial makeTrial(const std::vector<std::shared_ptr<const MapRayCaster>>& maps, std::mt19937_64& rng)
+/// Readings per trial, drawn uniformly from [kMinReadings, kMaxReadings] unless told otherwise.
+constexpr int kMinReadings = 4;
+constexpr int kMaxReadings = 30;
+
+/// A random trial on one of @p maps: geometry, noise, k in [@p k_min, @p k_max] and the truth.
+inline Trial makeTrial(const std::vector<std::shared_ptr<const MapRayCaster>>& maps, std::mt19937_64& rng,
+                       int k_min = kMinReadings, int k_max = kMaxReadings)
 {
   std::uniform_int_distribution<int> pick_map(0, static_cast<int>(maps.size()) - 1), pick_geometry(0, kGeometries - 1),
-      pick_k(4, 30);
+      pick_k(k_min, k_max);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::normal_distribution<double> noise(0.0, 0.005);
   Trial trial;

@@ -3,11 +3,13 @@
 // per geometry and every failure; exits 1 when the truth was missed in a noise-free trial or a
 // certificate was contradicted.
 //   verify_localization [--trials N] [--minutes M] [--seed S] [--resolution N] [--map FILE.poly[:SCALE] ...]
-//                       [--random-maps N] [--buildings N]
+//                       [--random-maps N] [--buildings N] [--k MIN:MAX]
 // --map (repeatable) verifies on those polygon maps (scaled about the origin by SCALE), --random-maps
 // on N random star-shaped 70-gons (mean radius 2 m, radii 1 to 3 m), --buildings on N generated
 // 12 x 9 m buildings (1.2 m corridors, 3 m rooms, 10 cm walls), both drawn from the seed: maps no
-// test was tuned on. Without any of them, the three small built-in maps.
+// test was tuned on. Without any of them, the three small built-in maps. --k draws the readings per
+// trial from [MIN, MAX] (default 4:30, within [3, 100]) to hunt where a search is hardest (few
+// readings); at the default the trials of a seed are those of earlier builds.
 #include "generated_maps.h"
 #include "verification_trials.h"
 
@@ -37,7 +39,44 @@ struct Args
   std::vector<std::string> maps;  ///< FILE.poly[:SCALE]; none of these three: verification::smallMaps()
   int random_maps = 0;
   int buildings = 0;
+  int k_min = verification::kMinReadings;
+  int k_max = verification::kMaxReadings;
 };
+
+/// Readings per trial (--k): at least as many as the localizer takes, at most this many.
+constexpr int kMinK = 3;
+constexpr int kMaxK = 100;
+
+/// Parses --k's MIN:MAX into @p args; false (and a message) on anything else.
+bool parseK(const std::string& text, Args& args)
+{
+  const std::size_t colon = text.find(':');
+  int k_min = 0;
+  int k_max = 0;
+  try
+  {
+    if (colon == std::string::npos)
+    {
+      throw std::invalid_argument("--k: '" + text + "' is not MIN:MAX");
+    }
+    k_min = fdml_localization::core::parseInteger(text.substr(0, colon), "--k MIN");
+    k_max = fdml_localization::core::parseInteger(text.substr(colon + 1), "--k MAX");
+  }
+  catch (const std::invalid_argument& e)
+  {
+    std::cerr << "verify_localization: " << e.what() << "\n";
+    return false;
+  }
+  if (k_min < kMinK || k_max < k_min || k_max > kMaxK)
+  {
+    std::cerr << "verify_localization: --k needs " << kMinK << " <= MIN <= MAX <= " << kMaxK << ", got '" << text
+              << "'\n";
+    return false;
+  }
+  args.k_min = k_min;
+  args.k_max = k_max;
+  return true;
+}
 
 /// Generated maps beside the files: at most this many of each kind.
 constexpr double kMaxGenerated = 100;
@@ -49,6 +88,14 @@ bool parse(int argc, char** argv, Args& args)
     if (std::strcmp(argv[i], "--map") == 0)
     {
       args.maps.emplace_back(argv[i + 1]);
+      continue;
+    }
+    if (std::strcmp(argv[i], "--k") == 0)
+    {
+      if (!parseK(argv[i + 1], args))
+      {
+        return false;
+      }
       continue;
     }
     char* end = nullptr;
@@ -155,8 +202,8 @@ void report(const Args& args, const std::vector<std::string>& names, long trial_
             const verification::Figures (&total)[2],
             const verification::Figures (&by_geometry)[2][verification::kGeometries])
 {
-  std::printf("\n%ld trials per engine in %.0f s (seed %lu, resolution %d)\n", trial_count, seconds, args.seed,
-              args.resolution);
+  std::printf("\n%ld trials per engine in %.0f s (seed %lu, resolution %d, k %d to %d)\n", trial_count, seconds,
+              args.seed, args.resolution, args.k_min, args.k_max);
   for (std::size_t m = 0; m < names.size(); ++m)
   {
     std::printf("map %zu: %s\n", m, names[m].c_str());
@@ -178,7 +225,7 @@ int main(int argc, char** argv)
   if (!parse(argc, argv, args))
   {
     std::cerr << "usage: verify_localization [--trials N] [--minutes M] [--seed S] [--resolution N] "
-                 "[--map FILE.poly[:SCALE] ...] [--random-maps N] [--buildings N]\n";
+                 "[--map FILE.poly[:SCALE] ...] [--random-maps N] [--buildings N] [--k MIN:MAX]\n";
     return 2;
   }
   std::vector<std::shared_ptr<const MapRayCaster>> maps;
@@ -202,7 +249,7 @@ int main(int argc, char** argv)
     {
       break;
     }
-    const verification::Trial trial = verification::makeTrial(maps, rng);
+    const verification::Trial trial = verification::makeTrial(maps, rng, args.k_min, args.k_max);
     for (int e = 0; e < 2; ++e)
     {
       verification::Figures one;

@@ -10,6 +10,7 @@
 #   VERIFY_RESOLUTION=N                the engines' resolution (default 64)
 #   VERIFY_K=MIN:MAX                   readings per trial (default 4:30; 4:6 hunts where few
 #                                      readings leave thousands of leaves tied)
+#   VERIFY_FOV=DEG                     every reading a cone of that full field of view (0 to 180)
 set -euo pipefail
 source "$(dirname "$0")/common.sh"
 catkin_build verify_localization
@@ -22,6 +23,7 @@ done
 [ -z "${VERIFY_RANDOM_MAPS:-}" ] || map_args+=(--random-maps "$VERIFY_RANDOM_MAPS")
 [ -z "${VERIFY_BUILDINGS:-}" ] || map_args+=(--buildings "$VERIFY_BUILDINGS")
 [ -z "${VERIFY_K:-}" ] || map_args+=(--k "$VERIFY_K")
+[ -z "${VERIFY_FOV:-}" ] || map_args+=(--fov "$VERIFY_FOV")
 "$WS/devel/lib/fdml_localization/verify_localization" --trials "${VERIFY_TRIALS:-10000}" \
   --minutes "${VERIFY_MINUTES:-15}" --resolution "${VERIFY_RESOLUTION:-64}" --seed "${VERIFY_SEED:-16}" \
   "${map_args[@]}"

@@ -7,7 +7,7 @@
 #include "fdml_localization/core/localization/localizer.h"
 #include "fdml_localization/core/localization/robust_search.h"
 
-#include "verification_trials.h"
+#include "verification_checks.h"
 
 #include <gtest/gtest.h>
 

@@ -7,6 +7,7 @@
 
 #include "fdml_localization/core/localization/robust_search.h"
 
+#include <Eigen/Cholesky>
 #include <gtest/gtest.h>
 
 #include <random>

@@ -2,7 +2,7 @@
 // trials over reading geometries on small maps and on generated ones, both engines; the truth among the candidates in
 // every noise-free trial (both engines) and no certificate contradicted by the reference.
 #include "generated_maps.h"
-#include "verification_trials.h"
+#include "verification_checks.h"
 
 #include <gtest/gtest.h>
 

@@ -7,7 +7,7 @@
 // closer than the uniqueness distance; a large region with few finite readings; a truth the
 // seeding's sample test missed in a large conservative region.
 #include "generated_maps.h"
-#include "verification_trials.h"
+#include "verification_checks.h"
 
 #include <gtest/gtest.h>
 

@@ -3,15 +3,16 @@
 // per geometry and every failure; exits 1 when the truth was missed in a noise-free trial or a
 // certificate was contradicted.
 //   verify_localization [--trials N] [--minutes M] [--seed S] [--resolution N] [--map FILE.poly[:SCALE] ...]
-//                       [--random-maps N] [--buildings N] [--k MIN:MAX]
+//                       [--random-maps N] [--buildings N] [--k MIN:MAX] [--fov DEG]
 // --map (repeatable) verifies on those polygon maps (scaled about the origin by SCALE), --random-maps
 // on N random star-shaped 70-gons (mean radius 2 m, radii 1 to 3 m), --buildings on N generated
 // 12 x 9 m buildings (1.2 m corridors, 3 m rooms, 10 cm walls), both drawn from the seed: maps no
 // test was tuned on. Without any of them, the three small built-in maps. --k draws the readings per
 // trial from [MIN, MAX] (default 4:30, within [3, 100]) to hunt where a search is hardest (few
-// readings); at the default the trials of a seed are those of earlier builds.
+// readings); at the default the trials of a seed are those of earlier builds. --fov gives every
+// reading a cone of that full field of view [deg] (0 to 180): the same poses, cone ranges.
 #include "generated_maps.h"
-#include "verification_trials.h"
+#include "verification_checks.h"
 
 #include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/core/util/text_parsing.h"
@@ -39,8 +40,7 @@ struct Args
   std::vector<std::string> maps;  ///< FILE.poly[:SCALE]; none of these three: verification::smallMaps()
   int random_maps = 0;
   int buildings = 0;
-  int k_min = verification::kMinReadings;
-  int k_max = verification::kMaxReadings;
+  verification::TrialSpec spec;  ///< --k, --fov
 };
 
 /// Readings per trial (--k): at least as many as the localizer takes, at most this many.
@@ -73,8 +73,32 @@ bool parseK(const std::string& text, Args& args)
               << "'\n";
     return false;
   }
-  args.k_min = k_min;
-  args.k_max = k_max;
+  args.spec.k_min = k_min;
+  args.spec.k_max = k_max;
+  return true;
+}
+
+/// Parses --fov's DEG (the sensors' full field of view, [0, 180]) into @p args; false (and a
+/// message) on anything else.
+bool parseFov(const std::string& text, Args& args)
+{
+  double degrees = 0.0;
+  try
+  {
+    degrees = fdml_localization::core::parseNumber(text, "--fov");
+  }
+  catch (const std::invalid_argument& e)
+  {
+    std::cerr << "verify_localization: " << e.what() << "\n";
+    return false;
+  }
+  if (!(degrees >= 0.0 && degrees <= 180.0))
+  {
+    std::cerr << "verify_localization: --fov needs a field of view in [0, 180] degrees (0 = rays), got '" << text
+              << "'\n";
+    return false;
+  }
+  args.spec.half_angle = 0.5 * degrees * verification::kDeg;
   return true;
 }
 
@@ -90,9 +114,9 @@ bool parse(int argc, char** argv, Args& args)
       args.maps.emplace_back(argv[i + 1]);
       continue;
     }
-    if (std::strcmp(argv[i], "--k") == 0)
+    if (std::strcmp(argv[i], "--k") == 0 || std::strcmp(argv[i], "--fov") == 0)
     {
-      if (!parseK(argv[i + 1], args))
+      if (!(argv[i][2] == 'k' ? parseK(argv[i + 1], args) : parseFov(argv[i + 1], args)))
       {
         return false;
       }
@@ -202,8 +226,9 @@ void report(const Args& args, const std::vector<std::string>& names, long trial_
             const verification::Figures (&total)[2],
             const verification::Figures (&by_geometry)[2][verification::kGeometries])
 {
-  std::printf("\n%ld trials per engine in %.0f s (seed %lu, resolution %d, k %d to %d)\n", trial_count, seconds,
-              args.seed, args.resolution, args.k_min, args.k_max);
+  std::printf("\n%ld trials per engine in %.0f s (seed %lu, resolution %d, k %d to %d, field of view %g deg)\n",
+              trial_count, seconds, args.seed, args.resolution, args.spec.k_min, args.spec.k_max,
+              2.0 * args.spec.half_angle / verification::kDeg);
   for (std::size_t m = 0; m < names.size(); ++m)
   {
     std::printf("map %zu: %s\n", m, names[m].c_str());
@@ -225,7 +250,7 @@ int main(int argc, char** argv)
   if (!parse(argc, argv, args))
   {
     std::cerr << "usage: verify_localization [--trials N] [--minutes M] [--seed S] [--resolution N] "
-                 "[--map FILE.poly[:SCALE] ...] [--random-maps N] [--buildings N] [--k MIN:MAX]\n";
+                 "[--map FILE.poly[:SCALE] ...] [--random-maps N] [--buildings N] [--k MIN:MAX] [--fov DEG]\n";
     return 2;
   }
   std::vector<std::shared_ptr<const MapRayCaster>> maps;
@@ -249,7 +274,7 @@ int main(int argc, char** argv)
     {
       break;
     }
-    const verification::Trial trial = verification::makeTrial(maps, rng, args.k_min, args.k_max);
+    const verification::Trial trial = verification::makeTrial(maps, rng, args.spec);
     for (int e = 0; e < 2; ++e)
     {
       verification::Figures one;

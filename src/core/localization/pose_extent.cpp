@@ -1,7 +1,9 @@
 // widenAlongContinua(): a candidate's covariance widened along the directions in which its
 // pose can move while its readings keep agreeing (a corridor, parallel walls, a cone facing a
 // flat wall), where the polish's local derivative cannot see it; settleAlongContinua(): first
-// the exact place at such a continuum's end, where the polish has no gradient to reach it.
+// the exact place at such a continuum's end, where the polish has no gradient to reach it, or the
+// stretch of it explaining more readings (continuum_gain.h).
+#include "fdml_localization/core/localization/continuum_gain.h"
 #include "fdml_localization/core/localization/robust_search.h"
 
 #include <algorithm>
@@ -251,7 +253,20 @@ void settleAlongContinua(const MapRayCaster& map, const std::vector<Reading>& re
     // Along a continuum the pose is uncertain by far more than the noise (its covariance already
     // says so where the readings leave the direction undetermined, or once widened).
     const double spread = kContinuumSpread * settings.noise_sigma;
-    if (candidate.rms_residual < kExactRms || c.u.dot(widened.covariance * c.u) <= spread * spread)
+    if (c.u.dot(widened.covariance * c.u) <= spread * spread)
+    {
+      continue;
+    }
+    if (c.u(2) == 0.0)
+    {
+      Candidate gained = gainAlongContinuum(map, readings, settings, candidate, c.u.head<2>(), c.behind.ok, c.ahead.ok);
+      if (netConsensus(gained) > netConsensus(candidate) && betterCandidate(gained, best))
+      {
+        best = std::move(gained);
+        moved_on = true;
+      }
+    }
+    if (candidate.rms_residual < kExactRms)
     {
       continue;
     }

@@ -202,7 +202,10 @@ Candidate refineSeed(const MapRayCaster& map, const Pose2& seed, const std::vect
  *        consensus, an RMS within noise_sigma of it), the continuum it lay on stays plausible: the
  *        settled pose's covariance adds the candidate's widened one and the move's outer product,
  *        so that noisy readings never turn an honest spread along a corridor into a confident
- *        pose 50 cm from the truth. An exact candidate (RMS below 1e-6 m) is never moved.
+ *        pose 50 cm from the truth. Along each such direction that is a translation, a pose
+ *        explaining more readings (gainAlongContinuum(), within the probed ends: a side sensor
+ *        passing a door frame) replaces the candidate when it ranks before it; otherwise an exact
+ *        candidate (RMS below 1e-6 m) is never moved.
  */
 void settleAlongContinua(const MapRayCaster& map, const std::vector<Reading>& readings,
                          const RefinementSettings& settings, Candidate& candidate);

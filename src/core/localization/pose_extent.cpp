@@ -220,6 +220,47 @@ constexpr double kContinuumSpread = 3.0;
 /// corridor with range noise, one reading's root moves the RMS by a fraction of the noise.
 constexpr double kEndGain = 0.5;
 
+/// Replaces @p best by a better place than @p candidate (its @p residuals) along @p c, if one ranks
+/// before it (betterCandidate()): along a translation, one explaining more readings
+/// (gainAlongContinuum()); for a candidate short of exact, a crossing at either end
+/// (residualRoots()), polished, explaining more readings or at most halving its RMS. True when
+/// one did.
+bool betterAlong(const MapRayCaster& map, const std::vector<Reading>& readings, const RefinementSettings& settings,
+                 const Candidate& candidate, const std::vector<double>& residuals, const Continuum& c, Candidate& best)
+{
+  bool replaced = false;
+  if (c.u(2) == 0.0)
+  {
+    Candidate gained = gainAlongContinuum(map, readings, settings, candidate, c.u.head<2>(), c.behind.ok, c.ahead.ok);
+    if (netConsensus(gained) > netConsensus(candidate) && betterCandidate(gained, best))
+    {
+      best = std::move(gained);
+      replaced = true;
+    }
+  }
+  if (candidate.rms_residual < kExactRms)
+  {
+    return replaced;
+  }
+  for (const auto& [u, end] : { std::make_pair(c.u, c.ahead), std::make_pair(Eigen::Vector3d(-c.u), c.behind) })
+  {
+    for (const Pose2& root : std::isfinite(end.beyond) ?
+                                 residualRoots(map, readings, candidate, residuals, u, end.beyond) :
+                                 std::vector<Pose2>{})
+    {
+      Candidate polished = polishedFrom(map, readings, settings, candidate, root);
+      const bool gain =
+          netConsensus(polished) > netConsensus(candidate) || polished.rms_residual < kEndGain * candidate.rms_residual;
+      if (gain && betterCandidate(polished, best))
+      {
+        best = std::move(polished);
+        replaced = true;
+      }
+    }
+  }
+  return replaced;
+}
+
 }  // namespace
 
 Candidate polishedFrom(const MapRayCaster& map, const std::vector<Reading>& readings,
@@ -257,35 +298,7 @@ void settleAlongContinua(const MapRayCaster& map, const std::vector<Reading>& re
     {
       continue;
     }
-    if (c.u(2) == 0.0)
-    {
-      Candidate gained = gainAlongContinuum(map, readings, settings, candidate, c.u.head<2>(), c.behind.ok, c.ahead.ok);
-      if (netConsensus(gained) > netConsensus(candidate) && betterCandidate(gained, best))
-      {
-        best = std::move(gained);
-        moved_on = true;
-      }
-    }
-    if (candidate.rms_residual < kExactRms)
-    {
-      continue;
-    }
-    for (const auto& [u, end] : { std::make_pair(c.u, c.ahead), std::make_pair(Eigen::Vector3d(-c.u), c.behind) })
-    {
-      for (const Pose2& root : std::isfinite(end.beyond) ?
-                                   residualRoots(map, readings, candidate, residuals, u, end.beyond) :
-                                   std::vector<Pose2>{})
-      {
-        Candidate polished = polishedFrom(map, readings, settings, candidate, root);
-        const bool gain = netConsensus(polished) > netConsensus(candidate) ||
-                          polished.rms_residual < kEndGain * candidate.rms_residual;
-        if (gain && betterCandidate(polished, best))
-        {
-          best = std::move(polished);
-          moved_on = true;
-        }
-      }
-    }
+    moved_on = betterAlong(map, readings, settings, candidate, residuals, c, best) || moved_on;
   }
   if (!moved_on)
   {

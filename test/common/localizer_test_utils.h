@@ -4,6 +4,7 @@
 #include "fdml_localization/core/localization/adaptive/adaptive_search.h"
 #include "fdml_localization/core/localization/components.h"
 #include "fdml_localization/core/localization/localizer.h"
+#include "fdml_localization/core/localization/robust_search.h"
 #include "fdml_localization/core/map/map_io.h"
 #include "fdml_localization/core/localization/voxel/voxel_grid.h"
 
@@ -101,6 +102,16 @@ inline std::vector<Reading> exactReadings(const MapRayCaster& map, const Pose2& 
     readings.push_back(r);
   }
   return readings;
+}
+
+/// The refinement settings of the continuum tests (settleAlongContinua(), gainAlongContinuum()):
+/// eps 5 cm, noise 1 cm.
+inline RefinementSettings continuumSettings()
+{
+  RefinementSettings settings;
+  settings.agreement_tolerance = 0.05;
+  settings.noise_sigma = 0.01;
+  return settings;
 }
 
 /// k readings in place, 2 pi / k apart (the paper's protocol).

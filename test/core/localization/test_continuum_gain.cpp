@@ -43,14 +43,6 @@ std::vector<Reading> drivePastTheDoor(const MapRayCaster& map, const Pose2& trut
   return readings;
 }
 
-RefinementSettings gainSettings()
-{
-  RefinementSettings settings;
-  settings.agreement_tolerance = 0.05;
-  settings.noise_sigma = 0.01;
-  return settings;
-}
-
 TEST(GainAlongContinuum, FindsTheStretchWhereASideSensorPassesTheDoorPost)
 {
   const auto map = corridorWithDoor();
@@ -66,7 +58,7 @@ TEST(GainAlongContinuum, FindsTheStretchWhereASideSensorPassesTheDoorPost)
   ASSERT_LT(start.rms_residual, kExactRms);
 
   const Candidate gained =
-      gainAlongContinuum(*map, readings, gainSettings(), start, Eigen::Vector2d::UnitX(), 4.0, 0.11);
+      gainAlongContinuum(*map, readings, test::continuumSettings(), start, Eigen::Vector2d::UnitX(), 4.0, 0.11);
   EXPECT_EQ(gained.inliers, 24);
   EXPECT_EQ(gained.contradicted, 0);
   // Within the stretch the geometry allows, its middle (9.79 m) by construction.
@@ -78,7 +70,8 @@ TEST(GainAlongContinuum, FindsTheStretchWhereASideSensorPassesTheDoorPost)
 
   // Nothing to gain from the truth's stretch itself: the candidate comes back unchanged.
   const Candidate exact = verifiedCandidate(*map, truth, readings, 0.05);
-  const Candidate same = gainAlongContinuum(*map, readings, gainSettings(), exact, Eigen::Vector2d::UnitX(), 0.5, 0.5);
+  const Candidate same =
+      gainAlongContinuum(*map, readings, test::continuumSettings(), exact, Eigen::Vector2d::UnitX(), 0.5, 0.5);
   EXPECT_EQ(test::positionError(same.pose, truth), 0.0);
 }
 
@@ -91,7 +84,7 @@ TEST(SettleAlongContinua, MovesAnExactCandidateToWhereItExplainsMoreReadings)
   ensureCovariance(*map, readings, 0.01, candidate);
   ASSERT_EQ(netConsensus(candidate), 22);  // the reading into the door contradicts it
 
-  settleAlongContinua(*map, readings, gainSettings(), candidate);
+  settleAlongContinua(*map, readings, test::continuumSettings(), candidate);
   EXPECT_EQ(netConsensus(candidate), 24);
   EXPECT_GT(candidate.pose.x, 9.77);
   EXPECT_LT(candidate.pose.x, 9.81);

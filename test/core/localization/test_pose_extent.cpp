@@ -46,14 +46,6 @@ double mahalanobis2(const Candidate& candidate, const Pose2& p)
   return d.dot(candidate.covariance.ldlt().solve(d));
 }
 
-RefinementSettings settleSettings()
-{
-  RefinementSettings settings;
-  settings.agreement_tolerance = 0.05;
-  settings.noise_sigma = 0.01;
-  return settings;
-}
-
 // The corridor, 30 readings of which 23 are no-returns beyond 1.9 m (verification seed 103):
 // along the corridor only one reading (1.88 m, past a corner) fixes the pose. It is 2.1 cm short
 // for every pose behind the truth and grows 2.9 cm per cm beyond it: a place 20 cm back explains
@@ -80,7 +72,7 @@ TEST(SettleAlongContinua, ReachesTheExactPlaceAtTheEndOfACorridorContinuum)
   EXPECT_EQ(test::positionError(widened.pose, start.pose), 0.0);
 
   Candidate settled = start;
-  settleAlongContinua(*map, readings, settleSettings(), settled);
+  settleAlongContinua(*map, readings, test::continuumSettings(), settled);
   EXPECT_EQ(settled.inliers, 30);
   EXPECT_LT(settled.rms_residual, 1e-6);
   EXPECT_LT(test::positionError(settled.pose, truth), 1e-3);
@@ -116,7 +108,7 @@ TEST(SettleAlongContinua, MovesOnlyForAHalvedRmsAndStaysHonest)
     }
     const Candidate start = polishedCandidate(*map, noisy, truth);
     Candidate settled = start;
-    settleAlongContinua(*map, noisy, settleSettings(), settled);
+    settleAlongContinua(*map, noisy, test::continuumSettings(), settled);
     if (test::positionError(settled.pose, start.pose) > 0.0 || settled.pose.theta != start.pose.theta)
     {
       ++moved;
@@ -128,7 +120,7 @@ TEST(SettleAlongContinua, MovesOnlyForAHalvedRmsAndStaysHonest)
     const Candidate at_truth = polishedCandidate(*map, exact, truth);
     ASSERT_LT(at_truth.rms_residual, 1e-6) << trial;
     Candidate still = at_truth;
-    settleAlongContinua(*map, exact, settleSettings(), still);
+    settleAlongContinua(*map, exact, test::continuumSettings(), still);
     EXPECT_EQ(test::positionError(still.pose, at_truth.pose), 0.0) << trial;
   }
   // Some do move (3 of 200 with this seed, 41 and 55 cm along the corridor): the checks above ran.
@@ -162,7 +154,7 @@ TEST(SettleInNearBasins, LeavesABasinBesideAWallsJogForTheTruth)
   LocalizerOptions options;
   options.threads = 1;
   std::vector<Candidate> candidates{ stuck };
-  settleInNearBasins(map, readings, options, settleSettings(), candidates);
+  settleInNearBasins(map, readings, options, test::continuumSettings(), candidates);
   ASSERT_EQ(candidates.size(), 1u);
   EXPECT_EQ(candidates.front().inliers, 6);
   EXPECT_LT(candidates.front().rms_residual, 1e-6);
@@ -174,7 +166,7 @@ TEST(SettleInNearBasins, LeavesABasinBesideAWallsJogForTheTruth)
   const Candidate exact = polishedCandidate(map, readings, truth);
   ASSERT_LT(exact.rms_residual, 1e-6);
   std::vector<Candidate> kept{ exact };
-  settleInNearBasins(map, readings, options, settleSettings(), kept);
+  settleInNearBasins(map, readings, options, test::continuumSettings(), kept);
   EXPECT_EQ(test::positionError(kept.front().pose, exact.pose), 0.0);
   EXPECT_EQ(kept.front().pose.theta, exact.pose.theta);
 }

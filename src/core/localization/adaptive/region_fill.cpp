@@ -51,6 +51,13 @@ constexpr int kOwnPlacePass = -1;
 /// A place found this many leaves (in x, y and heading) from a candidate is that candidate's.
 constexpr double kNearLeaves = 3.0;
 
+/// A budget of @p box_tests box tests, or of @p reading_tests reading tests where fewer readings
+/// make each box test cheaper (kFillReadingTests, kProbeReadingTests): whichever is more.
+long testBudget(long box_tests, long reading_tests, const std::vector<Reading>& readings)
+{
+  return std::max(box_tests, reading_tests / std::max<long>(1, static_cast<long>(readings.size())));
+}
+
 /// A leaf no candidate accounts for, with its centre pose's net consensus and its region.
 struct OpenLeaf
 {
@@ -95,7 +102,7 @@ void screenOpenLeaves(const MapRayCaster& map, const std::vector<Reading>& readi
       --o.bound;
     }
   }
-  budget = std::max(kProbeBoxTests, kProbeReadingTests / std::max<long>(1, static_cast<long>(readings.size())));
+  budget = testBudget(kProbeBoxTests, kProbeReadingTests, readings);
   for (auto o = open.begin(); o != open.end() && budget > 0; ++o)
   {
     const bool none =
@@ -346,7 +353,7 @@ int fillUncoveredRegions(const MapRayCaster& map, const std::vector<LeafBox>& le
   const std::vector<std::size_t> order = searchOrder(open, target);
   state.budget = kOwnPlaceBoxTests;
   fillPass(map, readings, options, settings, open, order, kOwnPlacePass, state);
-  state.budget = std::max(kFillBoxTests, kFillReadingTests / std::max<long>(1, static_cast<long>(readings.size())));
+  state.budget = testBudget(kFillBoxTests, kFillReadingTests, readings);
   for (int pass = 0; pass < 2; ++pass)
   {
     fillPass(map, readings, options, settings, open, order, pass, state);

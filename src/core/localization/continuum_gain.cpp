@@ -50,12 +50,10 @@ void vertexCrossings(const MapRayCaster& map, const Pose2& pose, const Reading& 
 }
 
 /// Appends the offset between @p a and @p b along @p u where @p reading's residual from @p pose
-/// changes sign (bisected), if it does.
+/// changes sign (bisected) when its residuals there, @p r_a and @p r_b, differ in sign.
 void residualCrossing(const MapRayCaster& map, const Pose2& pose, const Reading& reading, const Eigen::Vector2d& u,
-                      double a, double b, std::vector<double>& offsets)
+                      double a, double b, double r_a, double r_b, std::vector<double>& offsets)
 {
-  const double r_a = readingResidual(map, shifted(pose, u, a), reading);
-  const double r_b = readingResidual(map, shifted(pose, u, b), reading);
   if (!std::isfinite(r_a) || !std::isfinite(r_b) || (r_a < 0.0) == (r_b < 0.0))
   {
     return;
@@ -90,6 +88,18 @@ std::vector<std::pair<double, double>> offsetsToTry(const MapRayCaster& map, con
     }
   }
   std::sort(cuts.begin(), cuts.end());
+  // The residual at every cut of each finite reading followed, cast once for both its stretches.
+  std::vector<std::vector<double>> at_cuts(readings.size());
+  for (std::size_t i = 0; i < readings.size(); ++i)
+  {
+    if (followed(candidate, readings, i) && std::isfinite(readings[i].range))
+    {
+      for (const double cut : cuts)
+      {
+        at_cuts[i].push_back(readingResidual(map, shifted(candidate.pose, u, cut), readings[i]));
+      }
+    }
+  }
   std::vector<std::pair<double, double>> tries;
   for (std::size_t j = 0; j + 1 < cuts.size(); ++j)
   {
@@ -97,9 +107,10 @@ std::vector<std::pair<double, double>> offsetsToTry(const MapRayCaster& map, con
     std::vector<double> roots;
     for (std::size_t i = 0; i < readings.size(); ++i)
     {
-      if (followed(candidate, readings, i) && std::isfinite(readings[i].range))
+      if (!at_cuts[i].empty())
       {
-        residualCrossing(map, candidate.pose, readings[i], u, cuts[j], cuts[j + 1], roots);
+        residualCrossing(map, candidate.pose, readings[i], u, cuts[j], cuts[j + 1], at_cuts[i][j], at_cuts[i][j + 1],
+                         roots);
       }
     }
     for (const double root : roots)

@@ -47,58 +47,49 @@ struct Args
 constexpr int kMinK = 3;
 constexpr int kMaxK = 100;
 
-/// Parses --k's MIN:MAX into @p args; false (and a message) on anything else.
-bool parseK(const std::string& text, Args& args)
+/// Parses --k's MIN:MAX into @p spec. @throws std::invalid_argument naming the flag.
+void parseK(const std::string& text, verification::TrialSpec& spec)
 {
   const std::size_t colon = text.find(':');
-  int k_min = 0;
-  int k_max = 0;
-  try
+  if (colon == std::string::npos)
   {
-    if (colon == std::string::npos)
-    {
-      throw std::invalid_argument("--k: '" + text + "' is not MIN:MAX");
-    }
-    k_min = fdml_localization::core::parseInteger(text.substr(0, colon), "--k MIN");
-    k_max = fdml_localization::core::parseInteger(text.substr(colon + 1), "--k MAX");
+    throw std::invalid_argument("--k: '" + text + "' is not MIN:MAX");
   }
-  catch (const std::invalid_argument& e)
-  {
-    std::cerr << "verify_localization: " << e.what() << "\n";
-    return false;
-  }
+  const int k_min = fdml_localization::core::parseInteger(text.substr(0, colon), "--k MIN");
+  const int k_max = fdml_localization::core::parseInteger(text.substr(colon + 1), "--k MAX");
   if (k_min < kMinK || k_max < k_min || k_max > kMaxK)
   {
-    std::cerr << "verify_localization: --k needs " << kMinK << " <= MIN <= MAX <= " << kMaxK << ", got '" << text
-              << "'\n";
-    return false;
+    throw std::invalid_argument("--k needs " + std::to_string(kMinK) + " <= MIN <= MAX <= " + std::to_string(kMaxK) +
+                                ", got '" + text + "'");
   }
-  args.spec.k_min = k_min;
-  args.spec.k_max = k_max;
-  return true;
+  spec.k_min = k_min;
+  spec.k_max = k_max;
 }
 
-/// Parses --fov's DEG (the sensors' full field of view, [0, 180]) into @p args; false (and a
-/// message) on anything else.
-bool parseFov(const std::string& text, Args& args)
+/// Parses --fov's DEG (the sensors' full field of view, [0, 180]) into @p spec.
+/// @throws std::invalid_argument naming the flag.
+void parseFov(const std::string& text, verification::TrialSpec& spec)
 {
-  double degrees = 0.0;
+  const double degrees = fdml_localization::core::parseNumber(text, "--fov");
+  if (!(degrees >= 0.0 && degrees <= 180.0))
+  {
+    throw std::invalid_argument("--fov needs a field of view in [0, 180] degrees (0 = rays), got '" + text + "'");
+  }
+  spec.half_angle = 0.5 * degrees * verification::kDeg;
+}
+
+/// parseK() or parseFov() as @p flag says; false (and a message) on a bad @p value.
+bool parseTrialFlag(const char* flag, const std::string& value, verification::TrialSpec& spec)
+{
   try
   {
-    degrees = fdml_localization::core::parseNumber(text, "--fov");
+    std::strcmp(flag, "--k") == 0 ? parseK(value, spec) : parseFov(value, spec);
   }
   catch (const std::invalid_argument& e)
   {
     std::cerr << "verify_localization: " << e.what() << "\n";
     return false;
   }
-  if (!(degrees >= 0.0 && degrees <= 180.0))
-  {
-    std::cerr << "verify_localization: --fov needs a field of view in [0, 180] degrees (0 = rays), got '" << text
-              << "'\n";
-    return false;
-  }
-  args.spec.half_angle = 0.5 * degrees * verification::kDeg;
   return true;
 }
 
@@ -116,7 +107,7 @@ bool parse(int argc, char** argv, Args& args)
     }
     if (std::strcmp(argv[i], "--k") == 0 || std::strcmp(argv[i], "--fov") == 0)
     {
-      if (!(argv[i][2] == 'k' ? parseK(argv[i + 1], args) : parseFov(argv[i + 1], args)))
+      if (!parseTrialFlag(argv[i], argv[i + 1], args.spec))
       {
         return false;
       }

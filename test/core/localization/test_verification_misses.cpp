@@ -363,6 +363,19 @@ TEST(PastMissesOnGeneratedMaps, FewReadingsSearchMoreLeaves)
                                   "2.6008200758407964 -2.5909744981158962");
 }
 
+// Nineteenth round, a generated random 70-gon (`verify_localization --seed 518 --random-maps 2
+// --buildings 2`, its map 0): turning in place, 2 of 30 readings return and 28 no-returns of
+// 1.13 m leave 12,222 leaves whose bound, 30, exceeds the best candidate's 29. The screens'
+// 100,000 box tests covered 4,887 of them, the fill spent its budget searching others unscreened,
+// and the adaptive engine missed the truth's 30. Screens now cover 300,000 box tests, and the
+// fill screens every such leaf before it searches it.
+TEST(PastMissesOnGeneratedMaps, EveryLeafBeyondTheTargetIsScreenedBeforeItIsSearched)
+{
+  expectTruthFoundOnGeneratedMaps(2, 2, 518,
+                                  "no-return map 0 k 30 exact truth (0.47423955836941056, 0.028430822566813507, "
+                                  "3.0500716360930005) max range 1.1297962459342457");
+}
+
 INSTANTIATE_TEST_SUITE_P(Engines, PastMisses, ::testing::Values(Engine::Voxel, Engine::Adaptive),
                          [](const ::testing::TestParamInfo<Engine>& info) {
                            return std::string(toString(info.param));

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 namespace fdml_localization
 {
@@ -145,8 +146,7 @@ bool readingMayExplain(const MapRayCaster& map, const Reading& reading, const Po
 int boxConsensusBound(const MapRayCaster& map, const std::vector<Reading>& readings, double range_tolerance,
                       const PoseBox& box, int needed)
 {
-  const Box2 positions{ Vec2(box.x0, box.y0), Vec2(box.x1, box.y1) };
-  if (!map.grid().anySegmentInBox(positions) && !map.isFree(0.5 * (positions.min + positions.max)))
+  if (outsideFreeSpace(map, Box2{ Vec2(box.x0, box.y0), Vec2(box.x1, box.y1) }))
   {
     return 0;
   }
@@ -157,6 +157,33 @@ int boxConsensusBound(const MapRayCaster& map, const std::vector<Reading>& readi
     count += readingMayExplain(map, readings[static_cast<std::size_t>(i)], box, range_tolerance) ? 1 : 0;
   }
   return count;
+}
+
+BoxConsensusTest::BoxConsensusTest(const MapRayCaster& map, const std::vector<Reading>& readings,
+                                   double range_tolerance)
+  : map_(map), readings_(readings), range_tolerance_(range_tolerance), order_(readings.size())
+{
+  std::iota(order_.begin(), order_.end(), std::size_t{ 0 });
+}
+
+bool BoxConsensusTest::reaches(const PoseBox& box, int needed)
+{
+  if (outsideFreeSpace(map_, Box2{ Vec2(box.x0, box.y0), Vec2(box.x1, box.y1) }))
+  {
+    return needed <= 0;
+  }
+  // Readings that may not explain a pose of the box, and how many may fail before needed is out of reach.
+  long spare = static_cast<long>(order_.size()) - needed;
+  for (std::size_t i = 0; i < order_.size() && spare >= 0; ++i)
+  {
+    if (!readingMayExplain(map_, readings_[order_[i]], box, range_tolerance_))
+    {
+      --spare;
+      std::rotate(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(i),
+                  order_.begin() + static_cast<std::ptrdiff_t>(i + 1));
+    }
+  }
+  return spare >= 0;
 }
 
 AdaptiveSearchResult adaptiveSearch(const MapRayCaster& map, const std::vector<Reading>& readings,

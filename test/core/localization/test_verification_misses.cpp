@@ -6,14 +6,9 @@
 // k' where the truth's seed fell short of the level another place reached first; a tied optimum
 // closer than the uniqueness distance; a large region with few finite readings; a truth the
 // seeding's sample test missed in a large conservative region.
-#include "generated_maps.h"
-#include "verification_checks.h"
+#include "past_misses.h"
 
 #include <gtest/gtest.h>
-
-#include <algorithm>
-#include <sstream>
-#include <utility>
 
 namespace fdml_localization
 {
@@ -22,51 +17,8 @@ namespace core
 namespace
 {
 namespace verification = core::verification;
-
-/// The trial a FAIL line's label (verification::trialLabel()) describes, noise-free.
-verification::Trial trialFrom(std::string label, const std::vector<std::shared_ptr<const MapRayCaster>>& maps)
-{
-  std::replace_if(
-      label.begin(), label.end(), [](char c) { return c == '(' || c == ')' || c == ','; }, ' ');
-  std::istringstream in(label);
-  std::string geometry, word;
-  int k = 0;
-  verification::Trial trial;
-  in >> geometry >> word >> trial.map >> word >> k >> word >> word >> trial.truth.x >> trial.truth.y >>
-      trial.truth.theta;
-  for (int g = 0; g < verification::kGeometries; ++g)
-  {
-    trial.geometry = geometry == verification::geometryName(g) ? g : trial.geometry;
-  }
-  double max_range = kInf;
-  std::vector<double> headings;
-  while (in >> word)
-  {
-    if (word == "range")
-    {
-      in >> max_range;
-    }
-    for (double h = 0.0; word == "headings" && in >> h;)
-    {
-      headings.push_back(h);
-    }
-  }
-  std::mt19937_64 rng(0);
-  std::vector<Pose2> offsets = verification::trialOffsets(
-      trial.geometry == verification::kRandom ? verification::kTurning : trial.geometry, k, rng);
-  for (std::size_t i = 0; i < headings.size() && i < offsets.size(); ++i)
-  {
-    offsets[i] = Pose2(0.0, 0.0, headings[i]);
-  }
-  const MapRayCaster& map = *maps[static_cast<std::size_t>(trial.map)];
-  trial.readings = test::exactReadings(map, trial.truth, offsets);
-  for (Reading& r : trial.readings)
-  {
-    r.max_range = max_range;
-    r.range = r.range > max_range ? kInf : r.range;
-  }
-  return trial;
-}
+using verification::expectTruthFound;
+using verification::trialFrom;
 
 /// FAIL lines of `verify_localization --seed 1` (6,000 trials) before the fixes, and later.
 const char* const kPastMisses[] = {
@@ -267,36 +219,6 @@ const BundledMiss kBundledMapMisses[] = {
   { "turning map 2 k 5 exact truth (30.200420693458543, 6.8371734082116813, 1.4644924455953543)", 64, Engine::Voxel },
 };
 
-/// The noise-free trial of @p label on @p maps, localized by @p engine at @p resolution: every
-/// failure of checkNoiseFree() (the truth missed, the best candidate inaccurate) added.
-void expectTruthFound(const std::vector<std::shared_ptr<const MapRayCaster>>& maps, const std::string& label,
-                      Engine engine, int resolution)
-{
-  const verification::Trial trial = trialFrom(label, maps);
-  Localizer localizer(maps[static_cast<std::size_t>(trial.map)], verification::trialOptions(engine, resolution));
-  verification::Figures figures;
-  verification::checkNoiseFree(localizer, trial, localizer.localize(trial.readings), label, figures);
-  for (const std::string& failure : figures.failures)
-  {
-    ADD_FAILURE() << toString(engine) << ", resolution " << resolution << ": " << failure;
-  }
-}
-
-/// expectTruthFound() for both engines at resolution 64 on the maps
-/// verification::generatedMaps(@p random_maps, @p buildings, @p seed) draws (verify_localization's).
-void expectTruthFoundOnGeneratedMaps(int random_maps, int buildings, std::uint64_t seed, const std::string& label)
-{
-  std::vector<std::shared_ptr<const MapRayCaster>> maps;
-  for (verification::GeneratedMap& generated : verification::generatedMaps(random_maps, buildings, seed))
-  {
-    maps.push_back(std::move(generated.map));
-  }
-  for (const Engine engine : { Engine::Voxel, Engine::Adaptive })
-  {
-    expectTruthFound(maps, label, engine, 64);
-  }
-}
-
 TEST(PastMissesOnBundledMaps, BothEnginesSearchEveryRegionReachingTheConsensus)
 {
   std::vector<std::shared_ptr<const MapRayCaster>> maps;
@@ -308,72 +230,6 @@ TEST(PastMissesOnBundledMaps, BothEnginesSearchEveryRegionReachingTheConsensus)
   {
     expectTruthFound(maps, miss.label, miss.engine, miss.resolution);
   }
-}
-
-// Sixteenth round, a generated map (`verify_localization --seed 312 --random-maps 2`): with 5
-// readings driving, ten places explain 5 of 5 with RMS of 0.9 to 6 mm; the best, 8.7 cm and
-// 1.5 deg from the truth, hits another wall with its back ray. The truth's leaf lay within its
-// uniqueness margins, so the fill took it for the candidate's own and never searched it. Leaves
-// within a best candidate's margins are searched first now, and the seed-308 best candidate of
-// the paper's floor plan (a basin 1.15 cm from the truth) has its own test (test_pose_extent.cpp).
-TEST(PastMissesOnGeneratedMaps, TheOwnPlaceOfABestCandidateIsSearched)
-{
-  expectTruthFoundOnGeneratedMaps(1, 0, 312,
-                                  "driving map 0 k 5 exact truth (-0.20409421871068378, -0.30737713061474903, "
-                                  "0.19741754104986731)");
-}
-
-// Seventeenth round, a generated building (`verify_localization --seed 501 --random-maps 2
-// --buildings 2`, its map 2): turning in place, 2 of 10 readings return and 8 no-returns of
-// 1.71 m leave a continuum of poses explaining all 10, the truth's 2.5 cm from a wall one
-// no-return excludes. The adaptive engine's polish slid along the two returns' continuum into
-// walls the no-returns exclude (9 explained, 1 contradicted, everywhere), and the fill's budget
-// ran out among 8,164 leaves reaching 10. The polish keeps clear of them now (a no-return it
-// counts is a one-sided bound).
-TEST(PastMissesOnGeneratedMaps, ThePolishKeepsClearOfTheWallsNoReturnsExclude)
-{
-  expectTruthFoundOnGeneratedMaps(0, 1, 501,
-                                  "no-return map 0 k 10 exact truth (8.4656908668182442, 1.7111956736015532, "
-                                  "-2.7183979719256448) max range 1.7116808934350787");
-}
-
-// Seventeenth round, a generated random 70-gon (`verify_localization --seed 510 --random-maps 3
-// --buildings 1`, its map 1): 4 readings in random directions, 18 to 38 cm. All 10,721 leaves
-// reach 4, the truth's centre explains 2 (a sub-box's 4), and the probes' 100,000 box tests never
-// reached its leaf: the adaptive engine returned eight places of RMS 0.01 to 2 mm, not the
-// truth's 0. Probes now spend as many reading tests as 100,000 box tests of 16 readings.
-TEST(PastMissesOnGeneratedMaps, FewReadingsProbeMoreLeaves)
-{
-  expectTruthFoundOnGeneratedMaps(2, 0, 510,
-                                  "random map 1 k 4 exact truth (0.77699579633644955, 1.0751764657102689, "
-                                  "2.5522632244101686) headings -0.017603549990038658 2.726527156001576 "
-                                  "-1.6403165907458692 -1.6586703756329839");
-}
-
-// Eighteenth round, a generated building (`verify_localization --seed 517 --random-maps 2
-// --buildings 2`, its map 2): 4 readings in random directions among alike rooms, 146 regions
-// reach 4. The adaptive engine returned four exact places in other rooms and five approximate
-// ones, not the truth's: the fill's 100,000 box tests ran out first. The fill now spends as many
-// reading tests as 100,000 box tests of 16 readings.
-TEST(PastMissesOnGeneratedMaps, FewReadingsSearchMoreLeaves)
-{
-  expectTruthFoundOnGeneratedMaps(2, 1, 517,
-                                  "random map 2 k 4 exact truth (1.2132590115259561, 4.6791739045668841, "
-                                  "-2.3113867201805776) headings -2.577072765627094 2.8887659904852487 "
-                                  "2.6008200758407964 -2.5909744981158962");
-}
-
-// Nineteenth round, a generated random 70-gon (`verify_localization --seed 518 --random-maps 2
-// --buildings 2`, its map 0): turning in place, 2 of 30 readings return and 28 no-returns of
-// 1.13 m leave 12,222 leaves whose bound, 30, exceeds the best candidate's 29. The screens'
-// 100,000 box tests covered 4,887 of them, the fill spent its budget searching others unscreened,
-// and the adaptive engine missed the truth's 30. Screens now cover 300,000 box tests, and the
-// fill screens every such leaf before it searches it.
-TEST(PastMissesOnGeneratedMaps, EveryLeafBeyondTheTargetIsScreenedBeforeItIsSearched)
-{
-  expectTruthFoundOnGeneratedMaps(2, 2, 518,
-                                  "no-return map 0 k 30 exact truth (0.47423955836941056, 0.028430822566813507, "
-                                  "3.0500716360930005) max range 1.1297962459342457");
 }
 
 INSTANTIATE_TEST_SUITE_P(Engines, PastMisses, ::testing::Values(Engine::Voxel, Engine::Adaptive),

@@ -146,17 +146,7 @@ bool readingMayExplain(const MapRayCaster& map, const Reading& reading, const Po
 int boxConsensusBound(const MapRayCaster& map, const std::vector<Reading>& readings, double range_tolerance,
                       const PoseBox& box, int needed)
 {
-  if (outsideFreeSpace(map, Box2{ Vec2(box.x0, box.y0), Vec2(box.x1, box.y1) }))
-  {
-    return 0;
-  }
-  int count = 0;
-  const int k = static_cast<int>(readings.size());
-  for (int i = 0; i < k && count + (k - i) >= needed; ++i)
-  {
-    count += readingMayExplain(map, readings[static_cast<std::size_t>(i)], box, range_tolerance) ? 1 : 0;
-  }
-  return count;
+  return BoxConsensusTest(map, readings, range_tolerance).bound(box, needed);
 }
 
 BoxConsensusTest::BoxConsensusTest(const MapRayCaster& map, const std::vector<Reading>& readings,
@@ -166,24 +156,29 @@ BoxConsensusTest::BoxConsensusTest(const MapRayCaster& map, const std::vector<Re
   std::iota(order_.begin(), order_.end(), std::size_t{ 0 });
 }
 
-bool BoxConsensusTest::reaches(const PoseBox& box, int needed)
+int BoxConsensusTest::bound(const PoseBox& box, int needed)
 {
   if (outsideFreeSpace(map_, Box2{ Vec2(box.x0, box.y0), Vec2(box.x1, box.y1) }))
   {
-    return needed <= 0;
+    return 0;
   }
-  // Readings that may not explain a pose of the box, and how many may fail before needed is out of reach.
-  long spare = static_cast<long>(order_.size()) - needed;
-  for (std::size_t i = 0; i < order_.size() && spare >= 0; ++i)
+  int count = 0;
+  const std::size_t k = order_.size();
+  for (std::size_t i = 0; i < k && count + static_cast<long>(k - i) >= needed; ++i)
   {
-    if (!readingMayExplain(map_, readings_[order_[i]], box, range_tolerance_))
+    if (readingMayExplain(map_, readings_[order_[i]], box, range_tolerance_))
     {
-      --spare;
+      ++count;
+    }
+    else
+    {
+      // The next box, nearby, is mostly ruled out by the same reading: it goes first. The ones
+      // tested before it move up by one, so none is tested twice.
       std::rotate(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(i),
                   order_.begin() + static_cast<std::ptrdiff_t>(i + 1));
     }
   }
-  return spare >= 0;
+  return count;
 }
 
 AdaptiveSearchResult adaptiveSearch(const MapRayCaster& map, const std::vector<Reading>& readings,

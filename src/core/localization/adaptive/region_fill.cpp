@@ -81,6 +81,24 @@ struct OpenLeaf
   bool screened;
 };
 
+/// Screens @p o (screenLeaf()) unless it was screened before, its box tests counted down in
+/// @p budget: true when no sub-box reaches its bound, which then drops by one. A search costs
+/// some fifty times a screen, and most leaves whose bound exceeds the target hold no sub-box
+/// reaching it (11,158 of 12,222, screenOpenLeaves()). The fill screens such a leaf the screens
+/// did not reach before it searches it (fillPass()).
+bool screenedOut(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
+                 OpenLeaf& o, long& budget)
+{
+  if (o.screened)
+  {
+    return false;
+  }
+  o.screened = true;
+  const bool out = !screenLeaf(map, o.leaf->box, readings, options, o.bound, kScreenDepth, o.centre, budget);
+  o.bound -= out ? 1 : 0;
+  return out;
+}
+
 /// Screens (screenLeaf()) the @p open leaves whose bound exceeds @p target (the answer then
 /// provably incomplete) while kScreenBoxTests last, the highest bounds first: their bound
 /// tightened, their centre the best of their deepest sub-boxes'. Box tests are cheap beside the
@@ -101,12 +119,7 @@ void screenOpenLeaves(const MapRayCaster& map, const std::vector<Reading>& readi
   long budget = kScreenBoxTests;
   for (std::size_t j = 0; j < order.size() && budget > 0 && open[order[j]].bound > target; ++j)
   {
-    OpenLeaf& o = open[order[j]];
-    o.screened = true;
-    if (!screenLeaf(map, o.leaf->box, readings, options, o.bound, kScreenDepth, o.centre, budget))
-    {
-      --o.bound;
-    }
+    screenedOut(map, readings, options, open[order[j]], budget);
   }
   budget = testBudget(kProbeBoxTests, kProbeReadingTests, readings);
   for (auto o = open.begin(); o != open.end() && budget > 0; ++o)
@@ -284,23 +297,6 @@ bool leftToFound(Accounting& found, const PoseBox& box, int pass, Candidate& riv
     rival = *near;
   }
   return false;
-}
-
-/// Screens @p o (screenLeaf()) unless screenOpenLeaves() did, its box tests counted down in
-/// @p budget: true when no sub-box reaches its bound, which then drops by one. A search costs
-/// some fifty times a screen, and most leaves whose bound exceeds the target hold no sub-box
-/// reaching it (11,158 of 12,222, screenOpenLeaves()).
-bool screenedOut(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
-                 OpenLeaf& o, long& budget)
-{
-  if (o.screened)
-  {
-    return false;
-  }
-  o.screened = true;
-  const bool out = !screenLeaf(map, o.leaf->box, readings, options, o.bound, kScreenDepth, o.centre, budget);
-  o.bound -= out ? 1 : 0;
-  return out;
 }
 
 /// One pass over the open leaves in @p order. Pass 0 leaves for pass 1 (while the budget lasts) the leaves of

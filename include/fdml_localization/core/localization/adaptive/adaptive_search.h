@@ -128,8 +128,15 @@ public:
   /// @p map and @p readings must outlive the test; @p range_tolerance [m] as in readingMayExplain().
   BoxConsensusTest(const MapRayCaster& map, const std::vector<Reading>& readings, double range_tolerance);
 
-  /// True when some pose in @p box may explain @p needed readings (boxConsensusBound() >= @p needed).
-  bool reaches(const PoseBox& box, int needed);
+  /// boxConsensusBound() of @p box, its readings in this test's order (the same count whenever it
+  /// reaches @p needed).
+  int bound(const PoseBox& box, int needed);
+
+  /// True when some pose in @p box may explain @p needed readings (bound() >= @p needed).
+  bool reaches(const PoseBox& box, int needed)
+  {
+    return bound(box, needed) >= needed;
+  }
 
 private:
   const MapRayCaster& map_;

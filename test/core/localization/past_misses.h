@@ -18,7 +18,7 @@ namespace core
 {
 namespace verification
 {
-/// The trial a FAIL line's label (trialLabel()) describes, noise-free.
+/// The trial a FAIL line's label (trialLabel()) describes, noise-free (cones where it names a half angle).
 inline Trial trialFrom(std::string label, const std::vector<std::shared_ptr<const MapRayCaster>>& maps)
 {
   std::replace_if(
@@ -33,13 +33,17 @@ inline Trial trialFrom(std::string label, const std::vector<std::shared_ptr<cons
   {
     trial.geometry = geometry == geometryName(g) ? g : trial.geometry;
   }
-  double max_range = kInf;
+  double max_range = kInf, half_angle = 0.0;
   std::vector<double> headings;
   while (in >> word)
   {
     if (word == "range")
     {
       in >> max_range;
+    }
+    if (word == "angle")
+    {
+      in >> half_angle;
     }
     for (double h = 0.0; word == "headings" && in >> h;)
     {
@@ -56,6 +60,8 @@ inline Trial trialFrom(std::string label, const std::vector<std::shared_ptr<cons
   trial.readings = test::exactReadings(map, trial.truth, offsets);
   for (Reading& r : trial.readings)
   {
+    r.half_angle = half_angle;
+    r.range = half_angle > 0.0 ? coneRange(map, compose(trial.truth, r.offset), half_angle) : r.range;
     r.max_range = max_range;
     r.range = r.range > max_range ? kInf : r.range;
   }

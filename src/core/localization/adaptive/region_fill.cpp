@@ -61,6 +61,17 @@ long testBudget(long box_tests, long reading_tests, const std::vector<Reading>& 
   return std::max(box_tests, reading_tests / std::max<long>(1, static_cast<long>(readings.size())));
 }
 
+/// True when @p candidate accounts for the leaves its continuum reaches: its residuals within the
+/// range noise (RMS at most @p noise [m]). A place there can then only tie it, while beside a
+/// continuum's candidate with a larger RMS an exact place can lie on the continuum: 4 cones
+/// driving in a building, a candidate with an RMS of 25 mm and a standard deviation of 14.9 m
+/// along a corridor reached the truth's leaf 5.1 m away, and the fill, leaving such leaves to its
+/// second pass, never searched it (verification seed 802).
+bool settled(const Candidate& candidate, double noise)
+{
+  return candidate.rms_residual <= noise;
+}
+
 /// A leaf no candidate accounts for, with its centre pose's net consensus and its region.
 struct OpenLeaf
 {
@@ -72,7 +83,7 @@ struct OpenLeaf
   /// sub-box reaching the count.
   int bound;
   /// The candidate whose continuum reaches the leaf (inliers -1: none): a place found in the
-  /// leaf joins only when better than it.
+  /// leaf joins only when better than it; the leaf waits for pass 1 where the rival is settled().
   Candidate rival;
   /// Within the uniqueness margins of a candidate at the best consensus (its rival), not holding
   /// its pose: searched first (kOwnPlacePass).
@@ -134,12 +145,14 @@ void screenOpenLeaves(const MapRayCaster& map, const std::vector<Reading>& readi
 /// target, the highest first, up to kFillLeaves; those at the target spread, leavesToSearch()),
 /// each with its centre verified, in the order they are searched: round robin over their connected
 /// regions (the best leaf of every region, then the second best, ...; the best centres first within
-/// a rank). A region's place may lie far from its leaves' centres, on a large map many separate
+/// a rank). The centre of a leaf left to its own place or to a settled() rival (@p noise [m]) is
+/// verified when it is searched. A region's place may lie far from its leaves' centres, on a large map many separate
 /// regions reach the consensus (alike rooms, alcoves), and a continuum's candidate (sd of metres
 /// along a corridor) can be an approximate place while an exact one lies on it.
 std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<LeafBox>& leaves, int target,
                                  std::int64_t theta_cells, const std::vector<Reading>& readings,
-                                 const std::vector<Candidate>& candidates, const LocalizerOptions& options)
+                                 const std::vector<Candidate>& candidates, const LocalizerOptions& options,
+                                 double noise)
 {
   Accounting accounting(options);
   for (const Candidate& c : candidates)
@@ -168,10 +181,10 @@ std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<Leaf
     OpenLeaf o{ &leaf, Candidate(), labels[l], 0, leaf.count, Candidate(), own, false };
     o.rival.inliers = -1;
     const Candidate* rival = own ? held : accounting.continuumAt(leaf.box);
-    if (rival != nullptr)
+    o.rival = rival != nullptr ? *rival : o.rival;
+    if (own || (rival != nullptr && settled(*rival, noise)))
     {
-      o.rival = *rival;
-      o.centre.inliers = -1;  // verified when searched: own places first, continua in pass 1
+      o.centre.inliers = -1;  // verified when searched: own places first, settled continua in pass 1
     }
     else
     {
@@ -279,18 +292,18 @@ Candidate placeInLeaf(const MapRayCaster& map, const std::vector<Reading>& readi
   return place;
 }
 
-/// True when pass 0 leaves @p box to the places found so far: one lies in it, or one's continuum
-/// reaches it. Pass 1 searches such a leaf, @p rival then the better of itself and that place:
-/// the place found first in a region can be a local optimum of the residual while an exact one
-/// lies a leaf away (in a corridor, 4 of 4 readings with an rms of 11 mm, 85 cm from the truth's
-/// 0; in the warehouse, a ray grazing a corner, 45 um 21 cm from it).
-bool leftToFound(Accounting& found, const PoseBox& box, int pass, Candidate& rival)
+/// True when pass 0 leaves @p box to the places found so far: one lies in it, or the continuum of
+/// a settled() one (@p noise [m]) reaches it. Pass 1 searches such a leaf, @p rival then the better of itself and that
+/// place: the place found first in a region can be a local optimum of the residual while an exact one lies a leaf away
+/// (in a corridor, 4 of 4 readings with an rms of 11 mm, 85 cm from the truth's 0; in the warehouse, a ray grazing a
+/// corner, 45 um 21 cm from it).
+bool leftToFound(Accounting& found, const PoseBox& box, int pass, double noise, Candidate& rival)
 {
   const Candidate* holder = found.holder(box);
   const Candidate* near = holder != nullptr ? holder : found.continuumAt(box);
   if (near == nullptr || pass == 0)
   {
-    return near != nullptr;
+    return near != nullptr && (holder != nullptr || settled(*near, noise));
   }
   if (rival.inliers < 0 || betterCandidate(*near, rival))
   {
@@ -300,7 +313,7 @@ bool leftToFound(Accounting& found, const PoseBox& box, int pass, Candidate& riv
 }
 
 /// One pass over the open leaves in @p order. Pass 0 leaves for pass 1 (while the budget lasts) the leaves of
-/// regions holding a place and those on a candidate's continuum: mostly they hold those places again.
+/// regions holding a place and those on a settled() candidate's continuum: mostly they hold those places again.
 void fillPass(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
               const RefinementSettings& settings, std::vector<OpenLeaf>& open, const std::vector<std::size_t>& order,
               int pass, FillState& state)
@@ -312,15 +325,15 @@ void fillPass(const MapRayCaster& map, const std::vector<Reading>& readings, con
     const bool beyond = o.bound > state.target;
     const bool promising =
         beyond || (o.centre.inliers >= 0 && netConsensus(o.centre) >= state.target - kPromisingSlack);
-    const bool deferred =
-        !beyond && (o.rival.inliers >= 0 || (state.placed[static_cast<std::size_t>(o.region)] && !promising));
+    const bool deferred = !beyond && ((o.rival.inliers >= 0 && settled(o.rival, settings.noise_sigma)) ||
+                                      (state.placed[static_cast<std::size_t>(o.region)] && !promising));
     if (state.budget + (beyond ? kBeyondBoxTests : 0) <= 0 && (pass != 0 || state.tried >= kFillTries))
     {
       return;
     }
     Candidate rival = o.rival;
     if (state.searched[i] || o.bound < state.target || (pass == 0 && deferred) || (pass == kOwnPlacePass && !o.own) ||
-        (!beyond && leftToFound(state.found, o.leaf->box, pass, rival)))
+        (!beyond && leftToFound(state.found, o.leaf->box, pass, settings.noise_sigma, rival)))
     {
       continue;
     }
@@ -360,7 +373,8 @@ int fillUncoveredRegions(const MapRayCaster& map, const std::vector<LeafBox>& le
     return 0;
   }
   int target = netConsensus(result.candidates.front());
-  std::vector<OpenLeaf> open = openLeaves(map, leaves, target, theta_cells, readings, result.candidates, options);
+  std::vector<OpenLeaf> open =
+      openLeaves(map, leaves, target, theta_cells, readings, result.candidates, options, settings.noise_sigma);
   FillState state{ target, Accounting(options), result.candidates, false, {}, std::vector<char>(open.size(), 0),
                    0,      kFillBoxTests };
   int regions = 0;

@@ -197,12 +197,17 @@ void VoxelEngine::localizeRobust(const std::vector<Reading>& readings, Result& r
     const int target = netConsensus(result.candidates.front());
     std::vector<LeafBox> leaves = voxelLeaves(spec_, count_, target);
     // The box test bounds a voxel's consensus tighter than the count's distance bounds (and it
-    // stops early where the target is out of reach).
-#pragma omp parallel for schedule(dynamic, 256) num_threads(threads()) if (leaves.size() >= 1024)
-    for (long l = 0; l < static_cast<long>(leaves.size()); ++l)
+    // stops early where the target is out of reach). One test per thread: neighbouring voxels are
+    // mostly ruled out by the same reading (BoxConsensusTest).
+#pragma omp parallel num_threads(threads()) if (leaves.size() >= 1024)
     {
-      LeafBox& leaf = leaves[static_cast<std::size_t>(l)];
-      leaf.count = std::min(leaf.count, boxConsensusBound(*map_, readings, options_.range_tolerance, leaf.box, target));
+      BoxConsensusTest test(*map_, readings, options_.range_tolerance);
+#pragma omp for schedule(dynamic, 256)
+      for (long l = 0; l < static_cast<long>(leaves.size()); ++l)
+      {
+        LeafBox& leaf = leaves[static_cast<std::size_t>(l)];
+        leaf.count = std::min(leaf.count, test.bound(leaf.box, target));
+      }
     }
     leaves.erase(std::remove_if(leaves.begin(), leaves.end(), [&](const LeafBox& l) { return l.count < target; }),
                  leaves.end());

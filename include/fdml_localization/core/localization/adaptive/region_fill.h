@@ -31,7 +31,7 @@ namespace core
  *        1 um or more) that does not hold its pose: its own place, searched first (30,000 box
  *        tests), a better place there replacing it.
  *        Those whose bound exceeds the consensus are screened first (screenLeaf(), three
- *        halvings, 100,000 box tests in all), those at it probed (probeLeaf(), another 100,000, or
+ *        halvings, 300,000 box tests in all), those at it probed (probeLeaf(), another 100,000, or
  *        1,600,000 / k where fewer than 16 readings make box tests cheaper): a leaf with no
  *        sub-box reaching its bound has its bound lowered by one, the others are ranked by their
  *        best (probed: first) sub-box centre where better than theirs. Searched
@@ -40,10 +40,11 @@ namespace core
  *        @p theta_cells heading cells around the circle: every region's best leaf by its centre,
  *        then its second, ..., further leaves only while no place was found in the region or
  *        when their centre explains within two readings of the consensus), then, while the
- *        budget lasts, the leaves left: of regions holding a place, on a candidate's continuum,
- *        and those a place found by this fill lies in or whose centre its continuum reaches (a
- *        place there joins only when better than that candidate or place: the first place found
- *        in a region can be a local optimum of the residual). At least 64 leaves, more while
+ *        budget lasts, the leaves left: of regions holding a place, those a place found by this
+ *        fill lies in, and those on the continuum of a candidate or place found whose RMS is
+ *        within @p settings' noise_sigma (a continuum missing the readings by more holds no leaf
+ *        back; a place in a leaf on a continuum joins only when better than its candidate or
+ *        place: the first place found in a region can be a local optimum of the residual). At least 64 leaves, more while
  *        their box tests stay within 100,000, and 50,000 more for leaves whose bound exceeds the
  *        best place found (the answer then provably incomplete). Each leaf is searched through
  *        its sub-boxes (searchLeafForPlace()), the best centre refined with @p settings scaled to

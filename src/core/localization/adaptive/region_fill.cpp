@@ -54,19 +54,15 @@ constexpr int kOwnPlacePass = -1;
 /// A place found this many leaves (in x, y and heading) from a candidate is that candidate's.
 constexpr double kNearLeaves = 3.0;
 
-/// A budget of @p box_tests box tests, or of @p reading_tests reading tests where fewer readings
-/// make each box test cheaper (kFillReadingTests, kProbeReadingTests): whichever is more.
+/// @p box_tests box tests, or @p reading_tests reading tests where fewer readings make each cheaper: whichever is more.
 long testBudget(long box_tests, long reading_tests, const std::vector<Reading>& readings)
 {
   return std::max(box_tests, reading_tests / std::max<long>(1, static_cast<long>(readings.size())));
 }
 
-/// True when @p candidate accounts for the leaves its continuum reaches: its residuals within the
-/// range noise (RMS at most @p noise [m]). A place there can then only tie it, while beside a
-/// continuum's candidate with a larger RMS an exact place can lie on the continuum: 4 cones
-/// driving in a building, a candidate with an RMS of 25 mm and a standard deviation of 14.9 m
-/// along a corridor reached the truth's leaf 5.1 m away, and the fill, leaving such leaves to its
-/// second pass, never searched it (verification seed 802).
+/// True when @p candidate accounts for the leaves its continuum reaches: RMS within @p noise [m]. Beside a larger RMS
+/// an exact place can lie on the continuum (4 cones driving, a candidate of 25 mm with a standard deviation of 14.9 m
+/// along a corridor reached the truth's leaf 5.1 m away, left to pass 1 and never searched: verification seed 802).
 bool settled(const Candidate& candidate, double noise)
 {
   return candidate.rms_residual <= noise;

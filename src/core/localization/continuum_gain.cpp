@@ -11,9 +11,6 @@ namespace core
 {
 namespace
 {
-/// Bisections of a residual's sign change: a 4 m stretch down to 0.25 um.
-constexpr int kCrossingBisections = 24;
-
 /// @p pose moved by @p s [m] along the unit translation @p u, its heading kept.
 Pose2 shifted(const Pose2& pose, const Eigen::Vector2d& u, double s)
 {
@@ -50,21 +47,14 @@ void vertexCrossings(const MapRayCaster& map, const Pose2& pose, const Reading& 
 }
 
 /// Appends the offset between @p a and @p b along @p u where @p reading's residual from @p pose
-/// changes sign (bisected) when its residuals there, @p r_a and @p r_b, differ in sign.
+/// changes sign (residualSignChange()) when its residuals there, @p r_a and @p r_b, differ in sign.
 void residualCrossing(const MapRayCaster& map, const Pose2& pose, const Reading& reading, const Eigen::Vector2d& u,
                       double a, double b, double r_a, double r_b, std::vector<double>& offsets)
 {
-  if (!std::isfinite(r_a) || !std::isfinite(r_b) || (r_a < 0.0) == (r_b < 0.0))
+  if (std::isfinite(r_a) && std::isfinite(r_b) && (r_a < 0.0) != (r_b < 0.0))
   {
-    return;
+    offsets.push_back(residualSignChange(map, pose, reading, Eigen::Vector3d(u.x(), u.y(), 0.0), a, b, r_a, r_b));
   }
-  for (int i = 0; i < kCrossingBisections; ++i)
-  {
-    const double mid = 0.5 * (a + b);
-    const double r = readingResidual(map, shifted(pose, u, mid), reading);
-    (std::isfinite(r) && (r < 0.0) == (r_a < 0.0) ? a : b) = mid;
-  }
-  offsets.push_back(0.5 * (a + b));
 }
 
 /// True for a reading the offsets follow: outside @p candidate's inliers, a ray.

@@ -168,14 +168,10 @@ void widenWith(const std::vector<Continuum>& found, Candidate& candidate)
   }
 }
 
-/// Bisections of a residual's sign change: a 4 m probe down to 0.25 um.
-constexpr int kRootBisections = 24;
-
 /**
  * The poses between @p candidate's and the one @p beyond along @p direction where a finite inlier
  * of @p candidate explains its reading exactly: for each one whose residual changes sign on the
- * way (from its value in @p residuals, residualsAt()), the crossing (bisected), on the side of the
- * smaller residual.
+ * way (from its value in @p residuals, residualsAt()), the crossing (residualSignChange()).
  */
 std::vector<Pose2> residualRoots(const MapRayCaster& map, const std::vector<Reading>& readings,
                                  const Candidate& candidate, const std::vector<double>& residuals,
@@ -191,23 +187,11 @@ std::vector<Pose2> residualRoots(const MapRayCaster& map, const std::vector<Read
     }
     const double r0 = residuals[i];
     const double r1 = readingResidual(map, far, readings[i]);
-    if (!std::isfinite(r0) || !std::isfinite(r1) || (r0 < 0.0) == (r1 < 0.0))
+    if (std::isfinite(r0) && std::isfinite(r1) && (r0 < 0.0) != (r1 < 0.0))
     {
-      continue;
+      const double s = residualSignChange(map, candidate.pose, readings[i], direction, 0.0, beyond, r0, r1);
+      roots.push_back(moved(candidate.pose, direction, s));
     }
-    double lo = 0.0, hi = beyond, r_lo = r0, r_hi = r1;
-    for (int b = 0; b < kRootBisections; ++b)
-    {
-      const double mid = 0.5 * (lo + hi);
-      const double r = readingResidual(map, moved(candidate.pose, direction, mid), readings[i]);
-      if (!std::isfinite(r))
-      {
-        break;
-      }
-      ((r < 0.0) == (r0 < 0.0) ? lo : hi) = mid;
-      ((r < 0.0) == (r0 < 0.0) ? r_lo : r_hi) = r;
-    }
-    roots.push_back(moved(candidate.pose, direction, std::abs(r_lo) <= std::abs(r_hi) ? lo : hi));
   }
   return roots;
 }

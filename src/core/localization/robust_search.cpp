@@ -15,6 +15,8 @@ namespace core
 namespace
 {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+/// Bisections of a residual's sign change (residualSignChange()): a 4 m stretch down to 0.25 um.
+constexpr int kSignChangeBisections = 24;
 }  // namespace
 
 double predictedRange(const MapRayCaster& map, const Pose2& sensor, const Reading& reading, double max_range)
@@ -35,6 +37,25 @@ double readingResidual(const MapRayCaster& map, const Pose2& pose, const Reading
     return predictedRange(map, sensor, reading, reading.range + reach) - reading.range;
   }
   return std::min(0.0, predictedRange(map, sensor, reading, reading.max_range + 1.0) - reading.max_range);
+}
+
+double residualSignChange(const MapRayCaster& map, const Pose2& pose, const Reading& reading,
+                          const Eigen::Vector3d& direction, double a, double b, double r_a, double r_b)
+{
+  const bool negative_at_a = r_a < 0.0;
+  for (int i = 0; i < kSignChangeBisections; ++i)
+  {
+    const double mid = 0.5 * (a + b);
+    const Pose2 at(pose.x + mid * direction(0), pose.y + mid * direction(1), pose.theta + mid * direction(2));
+    const double r = readingResidual(map, at, reading);
+    if (!std::isfinite(r))
+    {
+      break;
+    }
+    ((r < 0.0) == negative_at_a ? a : b) = mid;
+    ((r < 0.0) == negative_at_a ? r_a : r_b) = r;
+  }
+  return std::abs(r_a) <= std::abs(r_b) ? a : b;
 }
 
 std::vector<double> vertexMargins(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings,

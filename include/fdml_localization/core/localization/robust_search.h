@@ -51,6 +51,17 @@ double predictedRange(const MapRayCaster& map, const Pose2& sensor, const Readin
 double readingResidual(const MapRayCaster& map, const Pose2& pose, const Reading& reading, double reach = kInf);
 
 /**
+ * @brief Where @p reading's residual (readingResidual()) changes sign between the poses @p a and
+ *        @p b along @p direction from @p pose (pose + s direction; s [m] for a unit translation),
+ *        its residuals there @p r_a and @p r_b finite and of opposite signs: bisected 24 times (a
+ *        4 m stretch down to 0.25 um), the end of the last bracket with the smaller residual. A
+ *        residual that is not finite on the way (the sensor outside free space) ends the bisection.
+ * @return the offset s of that end
+ */
+double residualSignChange(const MapRayCaster& map, const Pose2& pose, const Reading& reading,
+                          const Eigen::Vector3d& direction, double a, double b, double r_a, double r_b);
+
+/**
  * @brief Verifies @p pose: reading i agrees when its sensor position q (+) g_i is in free
  *        space and |h(q (+) g_i) - d_i| < eps (h: predictedRange(), the cone cast for a cone
  *        reading), or, for a no-return reading (d_i = +inf),

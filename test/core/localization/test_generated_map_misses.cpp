@@ -102,6 +102,20 @@ TEST(PastMissesOnGeneratedMaps, AContinuumBeyondTheNoiseHoldsNoLeafBack)
                                   "-2.1915221282346047) half angle 0.23561944901923448");
 }
 
+// Twentieth round, a generated random 70-gon (`verify_localization --seed 805 --fov 27 --k 4:6
+// --random-maps 2 --buildings 2`, its map 0): 4 cones in random directions. The truth's leaf
+// (28,725 open) lay on the continuum of an exact candidate explaining 3 of 4, which the fill took
+// to account for it, and the adaptive engine missed the truth's 4 of 4. Candidates short of the
+// fill's target now account for no leaf: the truth's then ranks first.
+TEST(PastMissesOnGeneratedMaps, ACandidateShortOfTheTargetAccountsForNoLeaf)
+{
+  expectTruthFoundOnGeneratedMaps(2, 2, 805,
+                                  "random map 0 k 4 exact truth (0.0034793782346134172, 0.50392951050712309, "
+                                  "3.0676639966240487) half angle 0.23561944901923448 headings "
+                                  "-2.4637672127847159 -0.47787144752358213 -2.4640254625107163 "
+                                  "1.5348968303905455");
+}
+
 }  // namespace
 }  // namespace core
 }  // namespace fdml_localization

@@ -153,7 +153,10 @@ std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<Leaf
   Accounting accounting(options);
   for (const Candidate& c : candidates)
   {
-    accounting.add(c);
+    if (netConsensus(c) >= target)  // one short of the target accounts for no leaf reaching it
+    {
+      accounting.add(c);
+    }
   }
   int regions = 0;
   const std::vector<int> labels = leafComponents(leaves, target, theta_cells, regions);

@@ -25,8 +25,9 @@ namespace core
 /**
  * @brief Adds to @p result (ranked, de-duplicated, at most max_candidates) the places its
  *        candidates miss. Open: the @p leaves reaching the best candidate's net consensus whose
- *        box holds no candidate's pose (within the uniqueness margins); a leaf whose centre lies
- *        within 3 sigma of a candidate's covariance grown by the leaf's size is on its continuum.
+ *        box holds the pose (within the uniqueness margins) of no candidate reaching it; a leaf
+ *        whose centre lies within 3 sigma of such a candidate's covariance grown by the leaf's
+ *        size is on its continuum (a candidate short of the consensus accounts for no leaf).
  *        Open too: a leaf within the margins of a candidate at that consensus, short of exact (RMS
  *        1 um or more) that does not hold its pose: its own place, searched first (30,000 box
  *        tests), a better place there replacing it.

@@ -106,16 +106,15 @@ bool screenedOut(const MapRayCaster& map, const std::vector<Reading>& readings, 
   return out;
 }
 
-/// Screens (screenLeaf()) the @p open leaves whose bound exceeds @p target (the answer then
-/// provably incomplete) while kScreenBoxTests last, the highest bounds first: their bound
-/// tightened, their centre the best of their deepest sub-boxes'. Box tests are cheap beside the
-/// verifications and refinements of a leaf's search, and most such leaves hold no place (in a
-/// corridor with 13 short no-returns of 16 readings, 305 of 5,251 keep a sub-box 7.8 cm wide).
-/// Leaves at the target are probed instead (probeLeaf(), in their spread order while
-/// kProbeBoxTests or kProbeReadingTests last): a screen costs a quarter more time where readings
-/// are mostly no-returns. In a floor plan of half-metre corridors, 2,392 of 3,879 leaves held no sub-box reaching the
-/// target, and the truth's leaf, its centre explaining none of 6 readings, ranked 29th in its
-/// region and was never searched; probed, its centre explains 6 and it ranks first.
+/// Screens (screenLeaf()) the @p open leaves whose bound exceeds @p target (the answer then provably incomplete) while
+/// kScreenBoxTests last, the highest bounds first: their bound tightened, their centre the best of their deepest
+/// sub-boxes'. Box tests are cheap beside the verifications and refinements of a leaf's search, and most such leaves
+/// hold no place (in a corridor with 13 short no-returns of 16 readings, 305 of 5,251 keep a sub-box 7.8 cm wide).
+/// Leaves at the target are probed instead (probeLeaf(), in their spread order while kProbeBoxTests or
+/// kProbeReadingTests last): a screen costs a quarter more time where readings are mostly no-returns. In a floor plan
+/// of half-metre corridors, 2,392 of 3,879 leaves held no sub-box reaching the target, and the truth's leaf, its centre
+/// explaining none of 6 readings, ranked 29th in its region and was never searched; probed, its centre explains 6 and
+/// it ranks first.
 void screenOpenLeaves(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
                       int target, std::vector<OpenLeaf>& open)
 {
@@ -137,14 +136,13 @@ void screenOpenLeaves(const MapRayCaster& map, const std::vector<Reading>& readi
   }
 }
 
-/// The leaves reaching @p target that hold no candidate's pose (every one whose bound exceeds the
-/// target, the highest first, up to kFillLeaves; those at the target spread, leavesToSearch()),
-/// each with its centre verified, in the order they are searched: round robin over their connected
-/// regions (the best leaf of every region, then the second best, ...; the best centres first within
-/// a rank). The centre of a leaf left to its own place or to a settled() rival (@p noise [m]) is
-/// verified when it is searched. A region's place may lie far from its leaves' centres, on a large map many separate
-/// regions reach the consensus (alike rooms, alcoves), and a continuum's candidate (sd of metres
-/// along a corridor) can be an approximate place while an exact one lies on it.
+/// The leaves reaching @p target that hold no candidate's pose (every one whose bound exceeds the target, the highest
+/// first, up to kFillLeaves; those at the target spread, leavesToSearch()), each with its centre verified, in the order
+/// they are searched: round robin over their connected regions (the best leaf of every region, then the second best,
+/// ...; the best centres first within a rank). The centre of a leaf left to its own place or to a settled() rival (@p
+/// noise [m]) is verified when it is searched. A region's place may lie far from its leaves' centres, on a large map
+/// many separate regions reach the consensus (alike rooms, alcoves), and a continuum's candidate (sd of metres along a
+/// corridor) can be an approximate place while an exact one lies on it.
 std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<LeafBox>& leaves, int target,
                                  std::int64_t theta_cells, const std::vector<Reading>& readings,
                                  const std::vector<Candidate>& candidates, const LocalizerOptions& options,

@@ -88,11 +88,10 @@ struct OpenLeaf
   bool screened;
 };
 
-/// Screens @p o (screenLeaf()) unless it was screened before, its box tests counted down in
-/// @p budget: true when no sub-box reaches its bound, which then drops by one. A search costs
-/// some fifty times a screen, and most leaves whose bound exceeds the target hold no sub-box
-/// reaching it (11,158 of 12,222, screenOpenLeaves()). The fill screens such a leaf the screens
-/// did not reach before it searches it (fillPass()).
+/// Screens @p o (screenLeaf()) unless it was screened before, its box tests counted down in @p budget: true when no
+/// sub-box reaches its bound, which then drops by one. A search costs some fifty times a screen, and most leaves whose
+/// bound exceeds the target hold no sub-box reaching it (11,158 of 12,222, screenOpenLeaves()). The fill screens such a
+/// leaf the screens did not reach before it searches it (fillPass()).
 bool screenedOut(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
                  OpenLeaf& o, long& budget)
 {

@@ -38,6 +38,12 @@ public:
     entries_.push_back(Entry{ candidate, Eigen::LDLT<Eigen::Matrix3d>(candidate.covariance), -1.0, -1.0 });
   }
 
+  /// Forgets every candidate.
+  void clear()
+  {
+    entries_.clear();
+  }
+
   /// The candidate whose pose lies in @p box (within the uniqueness margins), or null.
   const Candidate* holder(const PoseBox& box) const
   {

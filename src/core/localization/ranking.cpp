@@ -26,6 +26,12 @@ bool betterCandidate(const Candidate& a, const Candidate& b)
   return rankedBefore(a.inliers, a.contradicted, a.rms_residual, b.inliers, b.contradicted, b.rms_residual);
 }
 
+bool exactTie(const Candidate& a, const Candidate& b)
+{
+  return netConsensus(a) == netConsensus(b) && a.contradicted == b.contradicted && a.rms_residual < kExactRms &&
+         b.rms_residual < kExactRms;
+}
+
 std::vector<Candidate> rankAndDeduplicate(std::vector<Candidate> candidates, double distance, double angle,
                                           int max_candidates)
 {

@@ -116,6 +116,20 @@ TEST(PastMissesOnGeneratedMaps, ACandidateShortOfTheTargetAccountsForNoLeaf)
                                   "1.5348968303905455");
 }
 
+// Twentieth round, a generated random 70-gon (`verify_localization --seed 806 --fov 40 --k 4:6
+// --random-maps 2 --buildings 2`, its map 0): turning with 5 cones of 40 deg, mostly no-returns
+// of 1.46 m. The fill found the truth's exact place, which absorbed an exact place 3.4 cm and 5
+// deg from it; that place, its RMS smaller by rounding, then replaced it, and when another such
+// place replaced that one the truth was left outside every covariance (the adaptive engine
+// missed it). An exact tie never replaces the one known now (exactTie()).
+TEST(PastMissesOnGeneratedMaps, AnExactTieNeverReplacesTheOneKnown)
+{
+  expectTruthFoundOnGeneratedMaps(2, 2, 806,
+                                  "no-return map 0 k 5 exact truth (-0.051448516532837552, 0.34674065745390514, "
+                                  "-1.4424839408459498) half angle 0.3490658503988659 max range "
+                                  "1.4600386942470924");
+}
+
 }  // namespace
 }  // namespace core
 }  // namespace fdml_localization

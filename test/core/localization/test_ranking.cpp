@@ -75,6 +75,18 @@ TEST(RankAndAbsorbDuplicates, ADuplicateThatDoesNotTieLeavesTheCovarianceAlone)
   }
 }
 
+TEST(ExactTie, ExactPlacesOfTheSameConsensusTieWhateverTheirRounding)
+{
+  const Candidate a = exactCandidate(Pose2(), 5, 1.9e-16, 0.01, 0.01);
+  EXPECT_TRUE(exactTie(a, exactCandidate(Pose2(1.0, 0.0, 0.0), 5, 3.2e-16, 0.01, 0.01)));
+  EXPECT_TRUE(betterCandidate(a, exactCandidate(Pose2(), 5, 3.2e-16, 0.01, 0.01)));  // ranked by rounding
+  EXPECT_FALSE(exactTie(a, exactCandidate(Pose2(), 4, 0.0, 0.01, 0.01)));
+  EXPECT_FALSE(exactTie(a, exactCandidate(Pose2(), 5, 2e-6, 0.01, 0.01)));
+  Candidate contradicted = exactCandidate(Pose2(), 6, 0.0, 0.01, 0.01);
+  contradicted.contradicted = 1;
+  EXPECT_FALSE(exactTie(a, contradicted));  // the same net consensus, one reading contradicted
+}
+
 }  // namespace
 }  // namespace core
 }  // namespace fdml_localization

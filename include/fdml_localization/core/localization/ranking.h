@@ -19,6 +19,9 @@ namespace fdml_localization
 {
 namespace core
 {
+/// An RMS below this is exact: the rounding of a polish [m].
+constexpr double kExactRms = 1e-6;
+
 /// Net consensus of a candidate: inliers minus the readings the map contradicts at its pose.
 inline int netConsensus(const Candidate& c)
 {
@@ -33,6 +36,10 @@ bool rankedBefore(int inliers_a, int contradicted_a, double rms_a, int inliers_b
 
 /// The ranking order on candidates (see rankedBefore()).
 bool betterCandidate(const Candidate& a, const Candidate& b);
+
+/// True when @p a and @p b tie exactly: the same net consensus and contradicted readings, both RMS
+/// below kExactRms (what orders them then is the rounding of their polish).
+bool exactTie(const Candidate& a, const Candidate& b);
 
 /**
  * @brief Sorts best first and drops every candidate closer than (@p distance [m], @p angle

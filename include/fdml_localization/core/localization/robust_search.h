@@ -140,9 +140,6 @@ Eigen::Matrix3d oneDirectionLostCovariance(const MapRayCaster& map, const Pose2&
                                            const std::vector<Reading>& readings, const std::vector<bool>& use,
                                            double noise_sigma, double group_angle);
 
-/// An RMS below this is exact: the rounding of a polish [m].
-constexpr double kExactRms = 1e-6;
-
 /// Settings of refineSeed().
 struct RefinementSettings
 {

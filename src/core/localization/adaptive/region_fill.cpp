@@ -54,7 +54,9 @@ struct FillState
 /// either way a tie widens the covariance of the one kept to cover the other (absorbTiedDuplicates()). The office
 /// tracking launch once published such a near-duplicate (3 to 5 cm and 6 deg off) as the pose for half a second; and
 /// with 4 readings, an exact place 8.3 cm and 3.7 deg from the truth's, its RMS smaller by rounding, replaced it and
-/// its covariance of 7 mm and 0.3 deg left the truth out (verification seed 704).
+/// its covariance of 7 mm and 0.3 deg left the truth out (verification seed 704). An exact tie (exactTie()) never
+/// replaces: what the one known absorbed would be lost (seed 806: the truth's place, having absorbed a place 3.4 cm and
+/// 5 deg from it, was replaced by it, and a second such replacement left the truth uncovered).
 void admit(const LocalizerOptions& options, const RefinementSettings& settings, const PoseBox& leaf, Candidate place,
            FillState& state)
 {
@@ -70,7 +72,7 @@ void admit(const LocalizerOptions& options, const RefinementSettings& settings, 
     {
       continue;
     }
-    const bool replaces = betterCandidate(place, known);
+    const bool replaces = !exactTie(place, known) && betterCandidate(place, known);
     std::vector<Candidate> kept{ replaces ? std::move(place) : known };
     absorbTiedDuplicates({ replaces ? known : place }, near_xy, near_theta, settings.noise_sigma, kept);
     known = std::move(kept.front());

@@ -2,146 +2,133 @@
 // their FAIL lines with both engines: noise-free trials where the truth explains every reading.
 #include "past_misses.h"
 
+#include <cstdint>
+#include <string>
+
 namespace fdml_localization
 {
 namespace core
 {
 namespace
 {
-using verification::expectTruthFoundOnGeneratedMaps;
-
-// Sixteenth round, a generated map (`verify_localization --seed 312 --random-maps 2`): with 5
-// readings driving, ten places explain 5 of 5 with RMS of 0.9 to 6 mm; the best, 8.7 cm and
-// 1.5 deg from the truth, hits another wall with its back ray. The truth's leaf lay within its
-// uniqueness margins, so the fill took it for the candidate's own and never searched it. Leaves
-// within a best candidate's margins are searched first now, and the seed-308 best candidate of
-// the paper's floor plan (a basin 1.15 cm from the truth) has its own test (test_pose_extent.cpp).
-TEST(PastMissesOnGeneratedMaps, TheOwnPlaceOfABestCandidateIsSearched)
+/// A miss `verify_localization --seed S --random-maps R --buildings B` found, replayed from its
+/// FAIL line's label, and the lesson its fix taught (the test's name).
+struct PastMiss
 {
-  expectTruthFoundOnGeneratedMaps(1, 0, 312,
-                                  "driving map 0 k 5 exact truth (-0.20409421871068378, -0.30737713061474903, "
-                                  "0.19741754104986731)");
+  const char* lesson;
+  int random_maps;
+  int buildings;
+  std::uint64_t seed;
+  const char* label;
+};
+
+class PastMissesOnGeneratedMaps : public ::testing::TestWithParam<PastMiss>
+{};
+
+TEST_P(PastMissesOnGeneratedMaps, TheTruthIsFoundByBothEngines)
+{
+  const PastMiss& miss = GetParam();
+  verification::expectTruthFoundOnGeneratedMaps(miss.random_maps, miss.buildings, miss.seed, miss.label);
 }
 
-// Seventeenth round, a generated building (`verify_localization --seed 501 --random-maps 2
-// --buildings 2`, its map 2): turning in place, 2 of 10 readings return and 8 no-returns of
-// 1.71 m leave a continuum of poses explaining all 10, the truth's 2.5 cm from a wall one
-// no-return excludes. The adaptive engine's polish slid along the two returns' continuum into
-// walls the no-returns exclude (9 explained, 1 contradicted, everywhere), and the fill's budget
-// ran out among 8,164 leaves reaching 10. The polish keeps clear of them now (a no-return it
-// counts is a one-sided bound).
-TEST(PastMissesOnGeneratedMaps, ThePolishKeepsClearOfTheWallsNoReturnsExclude)
-{
-  expectTruthFoundOnGeneratedMaps(0, 1, 501,
-                                  "no-return map 0 k 10 exact truth (8.4656908668182442, 1.7111956736015532, "
-                                  "-2.7183979719256448) max range 1.7116808934350787");
-}
+const PastMiss kPastMisses[] = {
+  // Sixteenth round, a generated map (`verify_localization --seed 312 --random-maps 2`): with 5
+  // readings driving, ten places explain 5 of 5 with RMS of 0.9 to 6 mm; the best, 8.7 cm and
+  // 1.5 deg from the truth, hits another wall with its back ray. The truth's leaf lay within its
+  // uniqueness margins, so the fill took it for the candidate's own and never searched it. Leaves
+  // within a best candidate's margins are searched first now, and the seed-308 best candidate of
+  // the paper's floor plan (a basin 1.15 cm from the truth) has its own test (test_pose_extent.cpp).
+  { "TheOwnPlaceOfABestCandidateIsSearched", 1, 0, 312,
+    "driving map 0 k 5 exact truth (-0.20409421871068378, -0.30737713061474903, "
+    "0.19741754104986731)" },
+  // Seventeenth round, a generated building (`verify_localization --seed 501 --random-maps 2
+  // --buildings 2`, its map 2): turning in place, 2 of 10 readings return and 8 no-returns of
+  // 1.71 m leave a continuum of poses explaining all 10, the truth's 2.5 cm from a wall one
+  // no-return excludes. The adaptive engine's polish slid along the two returns' continuum into
+  // walls the no-returns exclude (9 explained, 1 contradicted, everywhere), and the fill's budget
+  // ran out among 8,164 leaves reaching 10. The polish keeps clear of them now (a no-return it
+  // counts is a one-sided bound).
+  { "ThePolishKeepsClearOfTheWallsNoReturnsExclude", 0, 1, 501,
+    "no-return map 0 k 10 exact truth (8.4656908668182442, 1.7111956736015532, "
+    "-2.7183979719256448) max range 1.7116808934350787" },
+  // Seventeenth round, a generated random 70-gon (`verify_localization --seed 510 --random-maps 3
+  // --buildings 1`, its map 1): 4 readings in random directions, 18 to 38 cm. All 10,721 leaves
+  // reach 4, the truth's centre explains 2 (a sub-box's 4), and the probes' 100,000 box tests never
+  // reached its leaf: the adaptive engine returned eight places of RMS 0.01 to 2 mm, not the
+  // truth's 0. Probes now spend as many reading tests as 100,000 box tests of 16 readings.
+  { "FewReadingsProbeMoreLeaves", 2, 0, 510,
+    "random map 1 k 4 exact truth (0.77699579633644955, 1.0751764657102689, "
+    "2.5522632244101686) headings -0.017603549990038658 2.726527156001576 "
+    "-1.6403165907458692 -1.6586703756329839" },
+  // Eighteenth round, a generated building (`verify_localization --seed 517 --random-maps 2
+  // --buildings 2`, its map 2): 4 readings in random directions among alike rooms, 146 regions
+  // reach 4. The adaptive engine returned four exact places in other rooms and five approximate
+  // ones, not the truth's: the fill's 100,000 box tests ran out first. The fill now spends as many
+  // reading tests as 100,000 box tests of 16 readings.
+  { "FewReadingsSearchMoreLeaves", 2, 1, 517,
+    "random map 2 k 4 exact truth (1.2132590115259561, 4.6791739045668841, "
+    "-2.3113867201805776) headings -2.577072765627094 2.8887659904852487 "
+    "2.6008200758407964 -2.5909744981158962" },
+  // Nineteenth round, a generated random 70-gon (`verify_localization --seed 518 --random-maps 2
+  // --buildings 2`, its map 0): turning in place, 2 of 30 readings return and 28 no-returns of
+  // 1.13 m leave 12,222 leaves whose bound, 30, exceeds the best candidate's 29. The screens'
+  // 100,000 box tests covered 4,887 of them, the fill spent its budget searching others unscreened,
+  // and the adaptive engine missed the truth's 30. Screens now cover 300,000 box tests, and the
+  // fill screens every such leaf before it searches it.
+  { "EveryLeafBeyondTheTargetIsScreenedBeforeItIsSearched", 2, 2, 518,
+    "no-return map 0 k 30 exact truth (0.47423955836941056, 0.028430822566813507, "
+    "3.0500716360930005) max range 1.1297962459342457" },
+  // Nineteenth round, a generated random 70-gon (`verify_localization --seed 704 --k 4:6
+  // --random-maps 2 --buildings 2`, its map 1): turning, 3 returns and a no-return; two exact
+  // places 8.3 cm and 3.7 deg apart. The adaptive engine found the truth's, then its region fill
+  // found the other, whose RMS was smaller by rounding, and the last de-duplication kept it alone
+  // with a covariance of 7 mm and 0.3 deg. A tie dropped as a duplicate widens the covariance of
+  // the one kept now (rankAndAbsorbDuplicates()).
+  { "ATieDroppedAsADuplicateWidensTheOneKept", 2, 2, 704,
+    "no-return map 1 k 4 exact truth (-0.7161075235797052, 0.51297329264951674, "
+    "2.4154447849871277) max range 1.6675948358539339" },
+  // Twentieth round, a generated building (`verify_localization --seed 802 --fov 27 --random-maps 2
+  // --buildings 2`, its map 2): 4 cones of 27 deg driving; 109 regions of 7,666 leaves reach 4. The
+  // truth's leaf lay on the continuum of a candidate with an RMS of 25 mm and a standard deviation
+  // of 14.9 m along a corridor, 5.1 m away, so the fill left it to its second pass, which its
+  // budget never reached, and both engines missed the truth. Only a continuum whose candidate's
+  // RMS is within the noise now holds its leaves back.
+  { "AContinuumBeyondTheNoiseHoldsNoLeafBack", 2, 2, 802,
+    "driving map 2 k 4 exact truth (10.454526011741928, 8.0254003166978354, "
+    "-2.1915221282346047) half angle 0.23561944901923448" },
+  // Twentieth round, a generated random 70-gon (`verify_localization --seed 805 --fov 27 --k 4:6
+  // --random-maps 2 --buildings 2`, its map 0): 4 cones in random directions. The truth's leaf
+  // (28,725 open) lay on the continuum of an exact candidate explaining 3 of 4, which the fill took
+  // to account for it, and the adaptive engine missed the truth's 4 of 4. Candidates short of the
+  // fill's target now account for no leaf: the truth's then ranks first.
+  { "ACandidateShortOfTheTargetAccountsForNoLeaf", 2, 2, 805,
+    "random map 0 k 4 exact truth (0.0034793782346134172, 0.50392951050712309, "
+    "3.0676639966240487) half angle 0.23561944901923448 headings "
+    "-2.4637672127847159 -0.47787144752358213 -2.4640254625107163 "
+    "1.5348968303905455" },
+  // Twentieth round, a generated random 70-gon (`verify_localization --seed 806 --fov 40 --k 4:6
+  // --random-maps 2 --buildings 2`, its map 0): turning with 5 cones of 40 deg, mostly no-returns
+  // of 1.46 m. The fill found the truth's exact place, which absorbed an exact place 3.4 cm and 5
+  // deg from it; that place, its RMS smaller by rounding, then replaced it, and when another such
+  // place replaced that one the truth was left outside every covariance (the adaptive engine
+  // missed it). An exact tie never replaces the one known now (exactTie()).
+  { "AnExactTieNeverReplacesTheOneKnown", 2, 2, 806,
+    "no-return map 0 k 5 exact truth (-0.051448516532837552, 0.34674065745390514, "
+    "-1.4424839408459498) half angle 0.3490658503988659 max range "
+    "1.4600386942470924" },
+  // Twentieth round, a generated building (`verify_localization --seed 807 --fov 27 --k 4:6
+  // --random-maps 2 --buildings 2`, its map 3): 4 cones of 27 deg driving; ten places explain 4 of
+  // 4, exact or nearly. The truth's leaf lay on the continuum of a candidate with an RMS of 1.8 mm
+  // (within the noise) and a standard deviation of 14.9 m along a corridor, 4 m away; the fill left
+  // it to pass 1, never reached, and the adaptive engine missed the truth's exact place. Where the
+  // best candidate is exact, only an exact candidate holds its continuum's leaves back now.
+  { "BesideAnExactBestOnlyAnExactContinuumHoldsLeavesBack", 2, 2, 807,
+    "driving map 3 k 4 exact truth (2.4171684338820869, 4.5984800968015671, "
+    "-1.6304329246665858) half angle 0.23561944901923448" },
+};
 
-// Seventeenth round, a generated random 70-gon (`verify_localization --seed 510 --random-maps 3
-// --buildings 1`, its map 1): 4 readings in random directions, 18 to 38 cm. All 10,721 leaves
-// reach 4, the truth's centre explains 2 (a sub-box's 4), and the probes' 100,000 box tests never
-// reached its leaf: the adaptive engine returned eight places of RMS 0.01 to 2 mm, not the
-// truth's 0. Probes now spend as many reading tests as 100,000 box tests of 16 readings.
-TEST(PastMissesOnGeneratedMaps, FewReadingsProbeMoreLeaves)
-{
-  expectTruthFoundOnGeneratedMaps(2, 0, 510,
-                                  "random map 1 k 4 exact truth (0.77699579633644955, 1.0751764657102689, "
-                                  "2.5522632244101686) headings -0.017603549990038658 2.726527156001576 "
-                                  "-1.6403165907458692 -1.6586703756329839");
-}
-
-// Eighteenth round, a generated building (`verify_localization --seed 517 --random-maps 2
-// --buildings 2`, its map 2): 4 readings in random directions among alike rooms, 146 regions
-// reach 4. The adaptive engine returned four exact places in other rooms and five approximate
-// ones, not the truth's: the fill's 100,000 box tests ran out first. The fill now spends as many
-// reading tests as 100,000 box tests of 16 readings.
-TEST(PastMissesOnGeneratedMaps, FewReadingsSearchMoreLeaves)
-{
-  expectTruthFoundOnGeneratedMaps(2, 1, 517,
-                                  "random map 2 k 4 exact truth (1.2132590115259561, 4.6791739045668841, "
-                                  "-2.3113867201805776) headings -2.577072765627094 2.8887659904852487 "
-                                  "2.6008200758407964 -2.5909744981158962");
-}
-
-// Nineteenth round, a generated random 70-gon (`verify_localization --seed 518 --random-maps 2
-// --buildings 2`, its map 0): turning in place, 2 of 30 readings return and 28 no-returns of
-// 1.13 m leave 12,222 leaves whose bound, 30, exceeds the best candidate's 29. The screens'
-// 100,000 box tests covered 4,887 of them, the fill spent its budget searching others unscreened,
-// and the adaptive engine missed the truth's 30. Screens now cover 300,000 box tests, and the
-// fill screens every such leaf before it searches it.
-TEST(PastMissesOnGeneratedMaps, EveryLeafBeyondTheTargetIsScreenedBeforeItIsSearched)
-{
-  expectTruthFoundOnGeneratedMaps(2, 2, 518,
-                                  "no-return map 0 k 30 exact truth (0.47423955836941056, 0.028430822566813507, "
-                                  "3.0500716360930005) max range 1.1297962459342457");
-}
-
-// Nineteenth round, a generated random 70-gon (`verify_localization --seed 704 --k 4:6
-// --random-maps 2 --buildings 2`, its map 1): turning, 3 returns and a no-return; two exact
-// places 8.3 cm and 3.7 deg apart. The adaptive engine found the truth's, then its region fill
-// found the other, whose RMS was smaller by rounding, and the last de-duplication kept it alone
-// with a covariance of 7 mm and 0.3 deg. A tie dropped as a duplicate widens the covariance of
-// the one kept now (rankAndAbsorbDuplicates()).
-TEST(PastMissesOnGeneratedMaps, ATieDroppedAsADuplicateWidensTheOneKept)
-{
-  expectTruthFoundOnGeneratedMaps(2, 2, 704,
-                                  "no-return map 1 k 4 exact truth (-0.7161075235797052, 0.51297329264951674, "
-                                  "2.4154447849871277) max range 1.6675948358539339");
-}
-
-// Twentieth round, a generated building (`verify_localization --seed 802 --fov 27 --random-maps 2
-// --buildings 2`, its map 2): 4 cones of 27 deg driving; 109 regions of 7,666 leaves reach 4. The
-// truth's leaf lay on the continuum of a candidate with an RMS of 25 mm and a standard deviation
-// of 14.9 m along a corridor, 5.1 m away, so the fill left it to its second pass, which its
-// budget never reached, and both engines missed the truth. Only a continuum whose candidate's
-// RMS is within the noise now holds its leaves back.
-TEST(PastMissesOnGeneratedMaps, AContinuumBeyondTheNoiseHoldsNoLeafBack)
-{
-  expectTruthFoundOnGeneratedMaps(2, 2, 802,
-                                  "driving map 2 k 4 exact truth (10.454526011741928, 8.0254003166978354, "
-                                  "-2.1915221282346047) half angle 0.23561944901923448");
-}
-
-// Twentieth round, a generated random 70-gon (`verify_localization --seed 805 --fov 27 --k 4:6
-// --random-maps 2 --buildings 2`, its map 0): 4 cones in random directions. The truth's leaf
-// (28,725 open) lay on the continuum of an exact candidate explaining 3 of 4, which the fill took
-// to account for it, and the adaptive engine missed the truth's 4 of 4. Candidates short of the
-// fill's target now account for no leaf: the truth's then ranks first.
-TEST(PastMissesOnGeneratedMaps, ACandidateShortOfTheTargetAccountsForNoLeaf)
-{
-  expectTruthFoundOnGeneratedMaps(2, 2, 805,
-                                  "random map 0 k 4 exact truth (0.0034793782346134172, 0.50392951050712309, "
-                                  "3.0676639966240487) half angle 0.23561944901923448 headings "
-                                  "-2.4637672127847159 -0.47787144752358213 -2.4640254625107163 "
-                                  "1.5348968303905455");
-}
-
-// Twentieth round, a generated random 70-gon (`verify_localization --seed 806 --fov 40 --k 4:6
-// --random-maps 2 --buildings 2`, its map 0): turning with 5 cones of 40 deg, mostly no-returns
-// of 1.46 m. The fill found the truth's exact place, which absorbed an exact place 3.4 cm and 5
-// deg from it; that place, its RMS smaller by rounding, then replaced it, and when another such
-// place replaced that one the truth was left outside every covariance (the adaptive engine
-// missed it). An exact tie never replaces the one known now (exactTie()).
-TEST(PastMissesOnGeneratedMaps, AnExactTieNeverReplacesTheOneKnown)
-{
-  expectTruthFoundOnGeneratedMaps(2, 2, 806,
-                                  "no-return map 0 k 5 exact truth (-0.051448516532837552, 0.34674065745390514, "
-                                  "-1.4424839408459498) half angle 0.3490658503988659 max range "
-                                  "1.4600386942470924");
-}
-
-// Twentieth round, a generated building (`verify_localization --seed 807 --fov 27 --k 4:6
-// --random-maps 2 --buildings 2`, its map 3): 4 cones of 27 deg driving; ten places explain 4 of
-// 4, exact or nearly. The truth's leaf lay on the continuum of a candidate with an RMS of 1.8 mm
-// (within the noise) and a standard deviation of 14.9 m along a corridor, 4 m away; the fill left
-// it to pass 1, never reached, and the adaptive engine missed the truth's exact place. Where the
-// best candidate is exact, only an exact candidate holds its continuum's leaves back now.
-TEST(PastMissesOnGeneratedMaps, BesideAnExactBestOnlyAnExactContinuumHoldsLeavesBack)
-{
-  expectTruthFoundOnGeneratedMaps(2, 2, 807,
-                                  "driving map 3 k 4 exact truth (2.4171684338820869, 4.5984800968015671, "
-                                  "-1.6304329246665858) half angle 0.23561944901923448");
-}
+INSTANTIATE_TEST_SUITE_P(Lessons, PastMissesOnGeneratedMaps, ::testing::ValuesIn(kPastMisses),
+                         [](const ::testing::TestParamInfo<PastMiss>& info) { return std::string(info.param.lesson); });
 
 }  // namespace
 }  // namespace core

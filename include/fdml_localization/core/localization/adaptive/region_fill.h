@@ -43,8 +43,8 @@ namespace core
  *        when their centre explains within two readings of the consensus), then, while the
  *        budget lasts, the leaves left: of regions holding a place, those a place found by this
  *        fill lies in, and those on the continuum of a candidate or place found whose RMS is
- *        within @p settings' noise_sigma, or exact where the best candidate is (a continuum
- *        missing the readings by more holds no leaf back; a place in a leaf on a continuum joins
+ *        within @p settings' noise_sigma and the best candidate's (or exact, where that is; a
+ *        continuum missing the readings by more holds no leaf back; a place in a leaf on a continuum joins
  *        only when better than its candidate or place: the first place found in a region can be
  *        a local optimum of the residual).
  *        At least 64 leaves, more while their box tests stay within 100,000, and 50,000 more for

@@ -64,25 +64,16 @@ void screenOpenLeaves(const MapRayCaster& map, const std::vector<Reading>& readi
 
 }  // namespace
 
-/// @p box_tests box tests, or @p reading_tests reading tests where fewer readings make each cheaper: whichever is more.
 long testBudget(long box_tests, long reading_tests, const std::vector<Reading>& readings)
 {
   return std::max(box_tests, reading_tests / std::max<long>(1, static_cast<long>(readings.size())));
 }
 
-/// True when @p candidate accounts for the leaves its continuum reaches: it reaches @p target (net consensus) and its
-/// RMS is within @p noise [m]. Beside a larger RMS an exact place can lie on the continuum (4 cones driving, a
-/// candidate of 25 mm with a standard deviation of 14.9 m along a corridor reached the truth's leaf 5.1 m away, left to
-/// pass 1 and never searched: verification seed 802); one short of the target, a place there beats it (seed 805).
-bool accountsFor(const Candidate& candidate, int target, double noise)
+bool accountsFor(const Candidate& candidate, int target, double settled)
 {
-  return netConsensus(candidate) >= target && candidate.rms_residual <= noise;
+  return netConsensus(candidate) >= target && candidate.rms_residual <= settled;
 }
 
-/// Screens @p o (screenLeaf()) unless it was screened before, its box tests counted down in @p budget: true when no
-/// sub-box reaches its bound, which then drops by one. A search costs some fifty times a screen, and most leaves whose
-/// bound exceeds the target hold no sub-box reaching it (11,158 of 12,222, screenOpenLeaves()). The fill screens such a
-/// leaf the screens did not reach before it searches it (fillPass()).
 bool screenedOut(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
                  OpenLeaf& o, long& budget)
 {
@@ -96,17 +87,10 @@ bool screenedOut(const MapRayCaster& map, const std::vector<Reading>& readings, 
   return out;
 }
 
-/// The leaves reaching @p target that hold no candidate's pose (every one whose bound exceeds the target, the highest
-/// first, up to kFillLeaves; those at the target spread, leavesToSearch()), each with its centre verified, in the order
-/// they are searched: round robin over their connected regions (the best leaf of every region, then the second best,
-/// ...; the best centres first within a rank). The centre of a leaf left to its own place or to a rival that
-/// accountsFor() it (@p noise [m]) is verified when it is searched. A region's place may lie far from its leaves'
-/// centres, on a large map many separate regions reach the consensus (alike rooms, alcoves), and a continuum's
-/// candidate (sd of metres along a corridor) can be an approximate place while an exact one lies on it.
 std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<LeafBox>& leaves, int target,
                                  std::int64_t theta_cells, const std::vector<Reading>& readings,
                                  const std::vector<Candidate>& candidates, const LocalizerOptions& options,
-                                 double noise)
+                                 double settled)
 {
   Accounting accounting(options);
   for (const Candidate& c : candidates)
@@ -129,19 +113,21 @@ std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<Leaf
     // place, where a better pose can lie in another basin: 8.7 cm from an RMS of 0.9 mm, a random
     // 70-gon).
     const Candidate* held = accounting.holder(leaf.box);
-    const bool own = held != nullptr && netConsensus(*held) >= target && held->rms_residual >= kExactRms &&
-                     !leaf.box.contains(held->pose, 0.0, 0.0);
+    const bool own = held != nullptr && held->rms_residual >= kExactRms && !leaf.box.contains(held->pose, 0.0, 0.0);
     if (leaf.count <= target && held != nullptr && !own)
     {
       continue;
     }
     OpenLeaf o{ &leaf, Candidate(), labels[l], 0, leaf.count, Candidate(), own, false };
-    o.rival.inliers = -1;
+    o.rival.inliers = -1;  // none
     const Candidate* rival = own ? held : accounting.continuumAt(leaf.box);
-    o.rival = rival != nullptr ? *rival : o.rival;
-    if (own || (rival != nullptr && accountsFor(*rival, target, noise)))
+    if (rival != nullptr)
     {
-      o.centre.inliers = -1;  // verified when searched: own places first, settled continua in pass 1
+      o.rival = *rival;
+    }
+    if (own || (rival != nullptr && accountsFor(*rival, target, settled)))
+    {
+      o.centre.inliers = -1;  // verified when searched: own places first, continua accounted for in pass 1
     }
     else
     {
@@ -162,9 +148,6 @@ std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<Leaf
   return open;
 }
 
-/// The order the open leaves are searched in: first those whose bound exceeds @p target, the
-/// highest bounds first (a place there beats the best candidate and raises the target), then all
-/// of them in openLeaves()' round robin.
 std::vector<std::size_t> searchOrder(const std::vector<OpenLeaf>& open, int target)
 {
   std::vector<std::size_t> order;

@@ -105,17 +105,17 @@ Candidate placeInLeaf(const MapRayCaster& map, const std::vector<Reading>& readi
 }
 
 /// True when pass 0 leaves @p box to the places found so far: one lies in it, or the continuum of
-/// one that accountsFor() it (@p target, @p noise [m]) reaches it. Pass 1 searches such a leaf, @p rival then the
+/// one that accountsFor() it (@p target, @p settled [m]) reaches it. Pass 1 searches such a leaf, @p rival then the
 /// better of itself and that place: the place found first in a region can be a local optimum of the residual while an
 /// exact one lies a leaf away (in a corridor, 4 of 4 readings with an rms of 11 mm, 85 cm from the truth's 0; in the
 /// warehouse, a ray grazing a corner, 45 um 21 cm from it).
-bool leftToFound(Accounting& found, const PoseBox& box, int pass, int target, double noise, Candidate& rival)
+bool leftToFound(Accounting& found, const PoseBox& box, int pass, int target, double settled, Candidate& rival)
 {
   const Candidate* holder = found.holder(box);
   const Candidate* near = holder != nullptr ? holder : found.continuumAt(box);
   if (near == nullptr || pass == 0)
   {
-    return near != nullptr && (holder != nullptr || accountsFor(*near, target, noise));
+    return near != nullptr && (holder != nullptr || accountsFor(*near, target, settled));
   }
   if (rival.inliers < 0 || betterCandidate(*near, rival))
   {

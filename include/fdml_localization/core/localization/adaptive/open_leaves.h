@@ -22,10 +22,11 @@ namespace core
 long testBudget(long box_tests, long reading_tests, const std::vector<Reading>& readings);
 
 /// True when @p candidate accounts for the leaves its continuum reaches: it reaches @p target (net consensus) and its
-/// RMS is within @p noise [m]. Beside a larger RMS an exact place can lie on the continuum (4 cones driving, a
-/// candidate of 25 mm with a standard deviation of 14.9 m along a corridor reached the truth's leaf 5.1 m away, left to
-/// pass 1 and never searched: verification seed 802); one short of the target, a place there beats it (seed 805).
-bool accountsFor(const Candidate& candidate, int target, double noise);
+/// RMS is within @p settled [m] (the fill's: noise_sigma, or the best candidate's RMS where smaller). Beside a larger
+/// RMS an exact place can lie on the continuum (4 cones driving, a candidate of 25 mm with a standard deviation of
+/// 14.9 m along a corridor reached the truth's leaf 5.1 m away, left to pass 1 and never searched: verification seed
+/// 802); one short of the target, a place there beats it (seed 805).
+bool accountsFor(const Candidate& candidate, int target, double settled);
 
 /// A leaf no candidate accounts for, with its centre pose's net consensus and its region.
 struct OpenLeaf
@@ -58,13 +59,13 @@ bool screenedOut(const MapRayCaster& map, const std::vector<Reading>& readings, 
 /// first, up to kFillLeaves; those at the target spread, leavesToSearch()), each with its centre verified, in the order
 /// they are searched: round robin over their connected regions (the best leaf of every region, then the second best,
 /// ...; the best centres first within a rank). The centre of a leaf left to its own place or to a rival that
-/// accountsFor() it (@p noise [m]) is verified when it is searched. A region's place may lie far from its leaves'
+/// accountsFor() it (@p settled [m]) is verified when it is searched. A region's place may lie far from its leaves'
 /// centres, on a large map many separate regions reach the consensus (alike rooms, alcoves), and a continuum's
 /// candidate (sd of metres along a corridor) can be an approximate place while an exact one lies on it.
 std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<LeafBox>& leaves, int target,
                                  std::int64_t theta_cells, const std::vector<Reading>& readings,
                                  const std::vector<Candidate>& candidates, const LocalizerOptions& options,
-                                 double noise);
+                                 double settled);
 
 /// The order the open leaves are searched in: first those whose bound exceeds @p target, the
 /// highest bounds first (a place there beats the best candidate and raises the target), then all

@@ -121,13 +121,17 @@ std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<Leaf
     OpenLeaf o{ &leaf, Candidate(), labels[l], 0, leaf.count, Candidate(), own, false };
     o.rival.inliers = -1;  // none
     const Candidate* rival = own ? held : accounting.continuumAt(leaf.box);
+    const bool accounted = rival != nullptr && accountsFor(*rival, target, settled);
     if (rival != nullptr)
     {
       o.rival = *rival;
     }
-    if (own || (rival != nullptr && accountsFor(*rival, target, settled)))
+    // The continuum of one short of exact is its own place too: turning with 4 cones of 40 deg, the truth's leaf lay
+    // 4.8 cm and 21 deg along that of the best candidate (6.5 mm), beyond its margins (verification seed 810).
+    o.own = own || (accounted && rival->rms_residual >= kExactRms);
+    if (accounted && !o.own)
     {
-      o.centre.inliers = -1;  // verified when searched: own places first, continua accounted for in pass 1
+      o.centre.inliers = -1;  // verified when searched in pass 1
     }
     else
     {

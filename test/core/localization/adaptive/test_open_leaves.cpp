@@ -1,6 +1,6 @@
 // Which leaves the region fill searches (open_leaves.h): a candidate holds a leaf back only when
 // it reaches the fill's target with an RMS within the noise (twentieth round, verification seeds
-// 802 and 805).
+// 802 and 805), and one short of exact has it searched first, as its own place (seed 810).
 #include "fdml_localization/core/localization/adaptive/open_leaves.h"
 
 #include "localizer_test_utils.h"
@@ -83,18 +83,26 @@ TEST_F(OpenLeavesTest, ALeafHoldingACandidateAtTheTargetIsNotOpenButOneShortOfIt
   EXPECT_EQ(short_of_it.front().centre.inliers, 6);  // the leaf's centre is the truth: verified
 }
 
-TEST_F(OpenLeavesTest, AContinuumHoldsTheLeafBackOnlyWithinTheNoise)
+TEST_F(OpenLeavesTest, AnExactContinuumHoldsTheLeafBackOneShortOfExactSearchesItFirst)
 {
   // A candidate 1 m away along x whose continuum (sd 2 m along x) reaches the leaf.
   const Pose2 along(q.x + 1.0, q.y, q.theta);
   const Eigen::Vector3d sd(2.0, 0.005, 0.005);
+  const std::vector<OpenLeaf> exact = open({ candidateAt(along, 6, 0.0, sd) });
+  ASSERT_EQ(exact.size(), 1u);
+  EXPECT_EQ(exact.front().rival.inliers, 6);
+  EXPECT_FALSE(exact.front().own);
+  EXPECT_LT(exact.front().centre.inliers, 0);  // left to pass 1, verified when searched
+  // Short of exact, within the noise: its own place, searched first (verification seed 810).
   const std::vector<OpenLeaf> settled = open({ candidateAt(along, 6, 0.001, sd) });
   ASSERT_EQ(settled.size(), 1u);
   EXPECT_EQ(settled.front().rival.inliers, 6);
-  EXPECT_LT(settled.front().centre.inliers, 0);  // left to pass 1, verified when searched
+  EXPECT_TRUE(settled.front().own);
+  EXPECT_EQ(settled.front().centre.inliers, 6);  // verified: the best of its own place first
   const std::vector<OpenLeaf> beyond = open({ candidateAt(along, 6, 0.025, sd) });
   ASSERT_EQ(beyond.size(), 1u);
-  EXPECT_EQ(beyond.front().rival.inliers, 6);   // a place there still has to beat it
+  EXPECT_EQ(beyond.front().rival.inliers, 6);  // a place there still has to beat it
+  EXPECT_FALSE(beyond.front().own);
   EXPECT_EQ(beyond.front().centre.inliers, 6);  // ranked now, searched in pass 0
 }
 

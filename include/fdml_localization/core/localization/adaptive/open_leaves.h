@@ -41,8 +41,9 @@ struct OpenLeaf
   /// The candidate whose continuum reaches the leaf (inliers -1: none): a place found in the
   /// leaf joins only when better than it; the leaf waits for pass 1 where the rival accountsFor() it.
   Candidate rival;
-  /// Within the uniqueness margins of a candidate at the best consensus (its rival), not holding
-  /// its pose: searched first (kOwnPlacePass).
+  /// Its rival's own place, searched first (kOwnPlacePass): within the uniqueness margins of a
+  /// candidate at the best consensus, not holding its pose, or on the continuum of one short of
+  /// exact (RMS kExactRms or more) that accountsFor() it.
   bool own;
   /// Screened (screenLeaf()): the fill searches no leaf whose bound exceeds its target unscreened.
   bool screened;
@@ -58,8 +59,8 @@ bool screenedOut(const MapRayCaster& map, const std::vector<Reading>& readings, 
 /// The leaves reaching @p target that hold no candidate's pose (every one whose bound exceeds the target, the highest
 /// first, up to kFillLeaves; those at the target spread, leavesToSearch()), each with its centre verified, in the order
 /// they are searched: round robin over their connected regions (the best leaf of every region, then the second best,
-/// ...; the best centres first within a rank). The centre of a leaf left to its own place or to a rival that
-/// accountsFor() it (@p settled [m]) is verified when it is searched. A region's place may lie far from its leaves'
+/// ...; the best centres first within a rank). The centre of a leaf left to an exact rival that accountsFor() it
+/// (@p settled [m]) is verified when it is searched. A region's place may lie far from its leaves'
 /// centres, on a large map many separate regions reach the consensus (alike rooms, alcoves), and a continuum's
 /// candidate (sd of metres along a corridor) can be an approximate place while an exact one lies on it.
 std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<LeafBox>& leaves, int target,

@@ -24,15 +24,6 @@ constexpr std::size_t kFillDeepBeam = 4;
 /// Deepest sub-boxes a screen verifies (screenLeaf()).
 constexpr std::size_t kScreenVerified = 8;
 
-/// A sub-box of a leaf that may still explain the target, with its centre pose verified.
-struct SubBox
-{
-  PoseBox box;
-  Candidate centre;
-  int within = 0;     ///< readings the centre explains within the box's band (boxBand())
-  double cost = 0.0;  ///< their sum of squared residuals, each relative to its band
-};
-
 /// The band [m] within which the centre of @p box may miss @p reading while a pose of the box
 /// explains it within @p eps: eps, half the box's diagonal in x, y, and half its heading span
 /// times the sensor's reach (mounting offset plus range).
@@ -42,32 +33,30 @@ double boxBand(const PoseBox& box, const Reading& reading, double eps)
   return eps + 0.5 * std::hypot(box.x1 - box.x0, box.y1 - box.y0) + 0.5 * (box.t1 - box.t0) * reach;
 }
 
+/// A sub-box of a leaf that may still explain the target, with its centre pose verified.
+struct SubBox
+{
+  PoseBox box;
+  Candidate centre;
+  BoxAgreement agreement;  ///< the centre's at the box's scale
+};
+
 /// @p box with its centre verified (eps) and its agreement at the box's own scale: where ranges are
 /// long, a 4.7 cm, 0.35 deg box's centre explains 2 of 5 readings within eps while every reading
 /// lies within its band, and ranked by the centre's consensus the box holding the truth left the
 /// beam (verification seed 103, voxel engine).
 SubBox verifiedSubBox(const MapRayCaster& map, const std::vector<Reading>& readings, double eps, const PoseBox& box)
 {
-  const Pose2 centre = box.centre();
-  const PoseEvaluation eval = evaluatePose(map, centre, readings, eps);
-  SubBox sub{ box, candidateFrom(centre, eval) };
-  for (std::size_t i = 0; i < readings.size(); ++i)
-  {
-    const double band = boxBand(box, readings[i], eps);
-    const double r = eval.residuals[i];
-    if (std::isfinite(r) ? std::abs(r) < band : eval.inlier_mask[i])
-    {
-      ++sub.within;
-      sub.cost += std::isfinite(r) ? (r / band) * (r / band) : 0.0;
-    }
-  }
+  SubBox sub;
+  sub.box = box;
+  sub.centre = verifiedBox(map, box, readings, eps, sub.agreement);
   return sub;
 }
 
-/// The beam's order: more readings within their bands, then the smaller relative cost.
+/// The beam's order (closerAgreement()).
 bool closerSubBox(const SubBox& a, const SubBox& b)
 {
-  return a.within != b.within ? a.within > b.within : a.cost < b.cost;
+  return closerAgreement(a.agreement, b.agreement);
 }
 
 /// Appends to @p kept the halves of @p box (every axis halved, 8) that may still explain
@@ -149,6 +138,30 @@ bool firstSubBoxReaching(BoxConsensusTest& test, const PoseBox& box, int needed,
 
 }  // namespace
 
+bool closerAgreement(const BoxAgreement& a, const BoxAgreement& b)
+{
+  return a.within != b.within ? a.within > b.within : a.cost < b.cost;
+}
+
+Candidate verifiedBox(const MapRayCaster& map, const PoseBox& box, const std::vector<Reading>& readings, double eps,
+                      BoxAgreement& agreement)
+{
+  const Pose2 centre = box.centre();
+  const PoseEvaluation eval = evaluatePose(map, centre, readings, eps);
+  agreement = BoxAgreement{ 0, 0.0 };
+  for (std::size_t i = 0; i < readings.size(); ++i)
+  {
+    const double band = boxBand(box, readings[i], eps);
+    const double r = eval.residuals[i];
+    if (std::isfinite(r) ? std::abs(r) < band : eval.inlier_mask[i])
+    {
+      ++agreement.within;
+      agreement.cost += std::isfinite(r) ? (r / band) * (r / band) : 0.0;
+    }
+  }
+  return candidateFrom(centre, eval);
+}
+
 Candidate searchLeafForPlace(const MapRayCaster& map, const LeafBox& leaf, const Candidate& centre,
                              const std::vector<Reading>& readings, const LocalizerOptions& options,
                              const RefinementSettings& settings, int target, long& box_tests)
@@ -156,7 +169,7 @@ Candidate searchLeafForPlace(const MapRayCaster& map, const LeafBox& leaf, const
   Candidate best = centre, refined = centre;
   PoseBox best_box = leaf.box;
   bool pending = false;  // best is not refined yet
-  std::vector<SubBox> level{ SubBox{ leaf.box, centre } };
+  std::vector<SubBox> level{ SubBox{ leaf.box, centre, BoxAgreement() } };
   BoxConsensusTest test(map, readings, options.range_tolerance);
   const auto refine = [&](const PoseBox& box, const Candidate& from) {
     const Candidate found = refinedNear(map, readings, options, settings, leaf.box, box, from);
@@ -193,7 +206,7 @@ Candidate searchLeafForPlace(const MapRayCaster& map, const LeafBox& leaf, const
     }
     // Where no centre is promising, the box closest at its own scale too (long ranges), when
     // promising at that scale.
-    const bool close = !next.empty() && next.front().within >= target - kPromisingSlack;
+    const bool close = !next.empty() && next.front().agreement.within >= target - kPromisingSlack;
     if (!promising && close && depth == kFillDepth && top != next.begin() &&
         refine(next.front().box, next.front().centre))
     {

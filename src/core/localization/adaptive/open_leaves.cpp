@@ -62,6 +62,36 @@ void screenOpenLeaves(const MapRayCaster& map, const std::vector<Reading>& readi
   }
 }
 
+/// The order of the leaves within a rank of openLeaves()' round robin: those whose centre is verified
+/// first, the best agreeing at the leaf's own scale first (closerAgreement()), then the best
+/// centre. By its centre, with 4 cones of 40 deg on a random 70-gon where 18,615 leaves reach 4,
+/// the truth's leaf (its centre explaining 2 within eps) ranked 1,855th in its region and was never
+/// searched; by its agreement, 48th (verification seed 810).
+bool rankedBefore(const OpenLeaf& a, const OpenLeaf& b)
+{
+  if (a.centre.inliers < 0 || b.centre.inliers < 0)
+  {
+    return a.centre.inliers >= 0 && b.centre.inliers < 0;
+  }
+  if (closerAgreement(a.agreement, b.agreement) || closerAgreement(b.agreement, a.agreement))
+  {
+    return closerAgreement(a.agreement, b.agreement);
+  }
+  return betterCandidate(a.centre, b.centre);
+}
+
+/// Ranks @p open within each of its @p regions (rankedBefore()) and sorts it by rank.
+void rankWithinRegions(int regions, std::vector<OpenLeaf>& open)
+{
+  std::stable_sort(open.begin(), open.end(), rankedBefore);
+  std::vector<int> ranked(static_cast<std::size_t>(regions), 0);
+  for (OpenLeaf& o : open)
+  {
+    o.rank = ranked[static_cast<std::size_t>(o.region)]++;
+  }
+  std::stable_sort(open.begin(), open.end(), [](const OpenLeaf& a, const OpenLeaf& b) { return a.rank < b.rank; });
+}
+
 }  // namespace
 
 long testBudget(long box_tests, long reading_tests, const std::vector<Reading>& readings)
@@ -118,7 +148,7 @@ std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<Leaf
     {
       continue;
     }
-    OpenLeaf o{ &leaf, Candidate(), labels[l], 0, leaf.count, Candidate(), own, false };
+    OpenLeaf o{ &leaf, Candidate(), labels[l], 0, leaf.count, Candidate(), own, false, BoxAgreement() };
     o.rival.inliers = -1;  // none
     const Candidate* rival = own ? held : accounting.continuumAt(leaf.box);
     const bool accounted = rival != nullptr && accountsFor(*rival, target, settled);
@@ -135,20 +165,12 @@ std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<Leaf
     }
     else
     {
-      o.centre = verifiedCandidate(map, leaf.box.centre(), readings, options.agreement_tolerance);
+      o.centre = verifiedBox(map, leaf.box, readings, options.agreement_tolerance, o.agreement);
     }
     open.push_back(std::move(o));
   }
   screenOpenLeaves(map, readings, options, target, open);
-  std::stable_sort(open.begin(), open.end(), [](const OpenLeaf& a, const OpenLeaf& b) {
-    return a.centre.inliers >= 0 && (b.centre.inliers < 0 || betterCandidate(a.centre, b.centre));
-  });
-  std::vector<int> ranked(static_cast<std::size_t>(regions), 0);
-  for (OpenLeaf& o : open)
-  {
-    o.rank = ranked[static_cast<std::size_t>(o.region)]++;
-  }
-  std::stable_sort(open.begin(), open.end(), [](const OpenLeaf& a, const OpenLeaf& b) { return a.rank < b.rank; });
+  rankWithinRegions(regions, open);
   return open;
 }
 

@@ -136,8 +136,8 @@ void fillPass(const MapRayCaster& map, const std::vector<Reading>& readings, con
     OpenLeaf& o = open[i];
     // A leaf whose bound exceeds the target may hold a better place: it is searched for one.
     const bool beyond = o.bound > state.target;
-    const bool promising =
-        beyond || (o.centre.inliers >= 0 && netConsensus(o.centre) >= state.target - kPromisingSlack);
+    const bool promising = beyond || o.agreement.within >= state.target ||
+                           (o.centre.inliers >= 0 && netConsensus(o.centre) >= state.target - kPromisingSlack);
     const bool deferred = !beyond && (accountsFor(o.rival, state.target, state.settled) ||
                                       (state.placed[static_cast<std::size_t>(o.region)] && !promising));
     if (state.budget + (beyond ? kBeyondBoxTests : 0) <= 0 && (pass != 0 || state.tried >= kFillTries))

@@ -31,6 +31,25 @@ std::vector<Candidate> leafLatticeBests(const MapRayCaster& map, const std::vect
  */
 RefinementSettings latticeRefinement(const LocalizerOptions& options, double cell_xy, double cell_theta);
 
+/// How well a box's centre agrees with the readings at the box's own scale.
+struct BoxAgreement
+{
+  int within = -1;    ///< readings explained within the band a pose of the box allows (-1: not verified)
+  double cost = 0.0;  ///< their sum of squared residuals, each relative to its band
+};
+
+/// More readings within their bands, then the smaller relative cost.
+bool closerAgreement(const BoxAgreement& a, const BoxAgreement& b);
+
+/**
+ * @brief The centre of @p box verified (agreement band @p eps [m]), and in @p agreement its
+ *        agreement at the box's scale: the band within which the centre may miss a reading while
+ *        a pose of the box explains it is eps plus half the box's diagonal in x, y plus half its
+ *        heading span times the reading's reach (mounting offset plus range).
+ */
+Candidate verifiedBox(const MapRayCaster& map, const PoseBox& box, const std::vector<Reading>& readings, double eps,
+                      BoxAgreement& agreement);
+
 /// A pose explaining at least the target less this many readings is promising: refined, and its
 /// leaf searched even where its region already holds a place (region_fill.h).
 constexpr int kPromisingSlack = 2;

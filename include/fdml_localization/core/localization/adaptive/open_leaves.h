@@ -7,6 +7,7 @@
 #pragma once
 
 #include "fdml_localization/core/localization/adaptive/adaptive_search.h"
+#include "fdml_localization/core/localization/adaptive/leaf_search.h"
 #include "fdml_localization/core/localization/localizer.h"
 #include "fdml_localization/core/localization/robust_search.h"
 
@@ -47,6 +48,8 @@ struct OpenLeaf
   bool own;
   /// Screened (screenLeaf()): the fill searches no leaf whose bound exceeds its target unscreened.
   bool screened;
+  /// Its centre's agreement at the leaf's scale (verifiedBox()), its rank's first key.
+  BoxAgreement agreement;
 };
 
 /// Screens @p o (screenLeaf()) unless it was screened before, its box tests counted down in @p budget: true when no
@@ -59,7 +62,8 @@ bool screenedOut(const MapRayCaster& map, const std::vector<Reading>& readings, 
 /// The leaves reaching @p target that hold no candidate's pose (every one whose bound exceeds the target, the highest
 /// first, up to kFillLeaves; those at the target spread, leavesToSearch()), each with its centre verified, in the order
 /// they are searched: round robin over their connected regions (the best leaf of every region, then the second best,
-/// ...; the best centres first within a rank). The centre of a leaf left to an exact rival that accountsFor() it
+/// ...; the best first within a rank), the best agreeing best at the leaf's own scale (closerAgreement()), then the
+/// best centre. The centre of a leaf left to an exact rival that accountsFor() it
 /// (@p settled [m]) is verified when it is searched. A region's place may lie far from its leaves'
 /// centres, on a large map many separate regions reach the consensus (alike rooms, alcoves), and a continuum's
 /// candidate (sd of metres along a corridor) can be an approximate place while an exact one lies on it.

@@ -125,8 +125,10 @@ bool leftToFound(Accounting& found, const PoseBox& box, int pass, int target, do
 }
 
 /// One pass over the open leaves in @p order. Pass 0 leaves for pass 1 (while the budget lasts) the leaves of
-/// regions holding a place and those on the continuum of a candidate that accountsFor() them: mostly they hold those
-/// places again.
+/// regions holding a place that are not promising and those on the continuum of a candidate that accountsFor() them:
+/// mostly they hold those places again. A leaf is promising when its centre explains within kPromisingSlack readings
+/// of the target, or the target within the bands of the leaf's own scale (its agreement: verification seed 811, the
+/// truth's leaf explained 1 of 6 readings at its centre and all 6 in their bands).
 void fillPass(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
               const RefinementSettings& settings, std::vector<OpenLeaf>& open, const std::vector<std::size_t>& order,
               int pass, FillState& state)

@@ -29,8 +29,9 @@ namespace core
  *        whose centre lies within 3 sigma of such a candidate's covariance grown by the leaf's
  *        size is on its continuum (a candidate short of the consensus accounts for no leaf).
  *        Open too: a leaf within the margins of a candidate at that consensus, short of exact (RMS
- *        1 um or more) that does not hold its pose: its own place, searched first (30,000 box
- *        tests), a better place there replacing it.
+ *        1 um or more) that does not hold its pose, or on the continuum of such a candidate that
+ *        accounts for it: its own place, searched first (30,000 box tests), a better place there
+ *        replacing it or joining beside it.
  *        Those whose bound exceeds the consensus are screened first (screenLeaf(), three
  *        halvings, 300,000 box tests in all), those at it probed (probeLeaf(), another 100,000, or
  *        1,600,000 / k where fewer than 16 readings make box tests cheaper): a leaf with no
@@ -38,9 +39,10 @@ namespace core
  *        best (probed: first) sub-box centre where better than theirs. Searched
  *        first the leaves whose bound exceeds the consensus (highest first; a place
  *        there raises it), then round robin over their connected regions (26 neighbours,
- *        @p theta_cells heading cells around the circle: every region's best leaf by its centre,
- *        then its second, ..., further leaves only while no place was found in the region or
- *        when their centre explains within two readings of the consensus), then, while the
+ *        @p theta_cells heading cells around the circle: every region's best leaf by its centre's
+ *        agreement at the leaf's scale (closerAgreement()) then by its centre, then its second,
+ *        ..., further leaves only while no place was found in the region, when their centre
+ *        explains within two readings of the consensus or that agreement reaches it), then, while the
  *        budget lasts, the leaves left: of regions holding a place, those a place found by this
  *        fill lies in, and those on the continuum of a candidate or place found whose RMS is
  *        within @p settings' noise_sigma and the best candidate's (or exact, where that is; a

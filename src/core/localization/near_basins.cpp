@@ -1,5 +1,6 @@
 // settleInNearBasins() (robust_search.h): the candidates' last polish, from a fine lattice around
 // them, where a ray passing a vertex splits the cost into basins a centimetre wide.
+#include "fdml_localization/core/localization/ranking.h"
 #include "fdml_localization/core/localization/region_starts.h"
 #include "fdml_localization/core/localization/robust_search.h"
 
@@ -16,6 +17,8 @@ namespace
 {
 /// Lattice rounds of settleInNearBasins() around a candidate, each around the better pose found.
 constexpr int kNearBasinRounds = 3;
+/// The lattice around an exact candidate (absorbExactTwins()) is this many steps wide.
+constexpr double kTwinSteps = 4.0;
 
 /// True when the cost may jump within about a lattice @p step_xy [m], @p step_theta [rad] of
 /// @p candidate: a finite inlier's ray passes a vertex within the move of its sensor there
@@ -83,6 +86,45 @@ void settleInNearBasin(const MapRayCaster& map, const std::vector<Reading>& read
     }
   }
 }
+/// Widens the covariance of an exact @p candidate near an edge of the cost (nearAnEdge()) to cover the exact places
+/// polished from a lattice kTwinSteps steps (@p step_xy [m], @p step_theta [rad]) around it that tie it within the
+/// uniqueness margins (absorbTiedDuplicates()): the engine returns one of such twins, and the readings cannot tell
+/// which. Rays with 6 readings, mostly no-returns: an exact place 4.8 cm and 2.5 deg from the exact truth, found by
+/// both engines while the truth was not (verification seed 815); a cone's edge sweeping a wall steeply: two exact
+/// headings 3.1 deg apart at the truth's position (seed 812).
+void absorbExactTwins(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
+                      const RefinementSettings& settings, double step_xy, double step_theta, Candidate& candidate)
+{
+  if (candidate.rms_residual >= kExactRms || !nearAnEdge(map, readings, candidate, step_xy, step_theta))
+  {
+    return;
+  }
+  std::vector<Candidate> twins;
+  for (int a = -1; a <= 1; ++a)
+  {
+    for (int b = -1; b <= 1; ++b)
+    {
+      for (int c = -1; c <= 1; ++c)
+      {
+        if (a == 0 && b == 0 && c == 0)
+        {
+          continue;
+        }
+        const Pose2& q = candidate.pose;
+        const Pose2 start(q.x + kTwinSteps * a * step_xy, q.y + kTwinSteps * b * step_xy,
+                          wrapAngle(q.theta + kTwinSteps * c * step_theta));
+        Candidate twin = polishedFrom(map, readings, settings, candidate, start);
+        if (twin.rms_residual < kExactRms)
+        {
+          twins.push_back(std::move(twin));
+        }
+      }
+    }
+  }
+  std::vector<Candidate> kept{ candidate };
+  absorbTiedDuplicates(twins, options.uniqueness_distance, options.uniqueness_angle, settings.noise_sigma, kept);
+  candidate.covariance = kept.front().covariance;
+}
 }  // namespace
 
 void settleInNearBasins(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
@@ -106,6 +148,7 @@ void settleInNearBasins(const MapRayCaster& map, const std::vector<Reading>& rea
   for (long j = 0; j < tied; ++j)
   {
     settleInNearBasin(map, readings, settings, step_xy, step_theta, candidates[static_cast<std::size_t>(j)]);
+    absorbExactTwins(map, readings, options, settings, step_xy, step_theta, candidates[static_cast<std::size_t>(j)]);
   }
   candidates = rankAndDeduplicate(std::move(candidates), options.uniqueness_distance, options.uniqueness_angle,
                                   options.max_candidates);

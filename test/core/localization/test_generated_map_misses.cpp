@@ -160,6 +160,19 @@ const PastMiss kPastMisses[] = {
     "-0.80011345436090897) half angle 0.3490658503988659 headings -0.85402637287407801 "
     "-0.71855961415384861 1.7749247103154593 -0.98676260491177059 -0.33981588082370884 "
     "-1.3981551376481045" },
+  // Twenty-first round (`--seed 815 --k 4:6 --random-maps 2 --buildings 2`, map 0, rays): 6
+  // readings, mostly no-returns of 1.5 m. Both engines returned an exact place 4.8 cm and 2.5 deg
+  // from the exact truth, its covariance leaving the truth out. An exact candidate's covariance
+  // covers the exact places that tie it near it now (absorbExactTwins()).
+  { "AnExactCandidateCoversItsExactTwins", 2, 2, 815,
+    "no-return map 0 k 6 exact truth (-0.74983390218240054, -0.21666281012618738, "
+    "-2.708006482237121) max range 1.5179613785744854" },
+  // Twenty-first round (`--seed 812 --fov 27 --k 4:6 --random-maps 2 --buildings 2`, map 0): 4
+  // cones of 27 deg; at the truth's position one cone's edge sweeps a wall steeply, and its
+  // residual crosses zero at two headings 3.1 deg apart. The adaptive engine returned the other.
+  { "AnExactCandidateCoversItsTwinAcrossAConeEdge", 2, 2, 812,
+    "grazing map 0 k 4 exact truth (0.41190213420785371, -0.73018129119911257, "
+    "-1.0128720771130686) half angle 0.23561944901923448" },
 };
 
 INSTANTIATE_TEST_SUITE_P(Lessons, PastMissesOnGeneratedMaps, ::testing::ValuesIn(kPastMisses),

@@ -262,8 +262,12 @@ Candidate polishedFrom(const MapRayCaster& map, const std::vector<Reading>& read
  *        cost has a basin per set of walls the rays hit, and the seeds' multi-start lattice is a
  *        cell wide: in the paper's floor plan scaled by 0.25, three rays hit a wall's jog 4 mm in
  *        front of the wall they hit from the truth, and the best candidate stopped 1.15 cm and
- *        0.52 deg from it (RMS 4.2 mm against 0). The candidates are ranked and de-duplicated
- *        again.
+ *        0.52 deg from it (RMS 4.2 mm against 0). An exact candidate near such an edge instead
+ *        has its covariance widened to cover the exact places polished from a lattice four steps
+ *        wide around it that tie it within the uniqueness margins (absorbTiedDuplicates()): two
+ *        exact places 4.8 cm and 2.5 deg apart, or 3.1 deg apart where a cone's edge sweeps a wall,
+ *        and the engine found the one the readings did not come from (verification seeds 815,
+ *        812). The candidates are ranked and de-duplicated again.
  * @param options range_tolerance, the uniqueness margins, max_candidates and threads
  * @param settings the polish's eps, noise_sigma and max_iterations
  * @param candidates ranked (rankAndDeduplicate()), the best first

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace fdml_localization
 {
@@ -40,6 +41,26 @@ bool nearAnEdge(const MapRayCaster& map, const std::vector<Reading>& readings, c
   return false;
 }
 
+/// The 26 poses of a lattice @p step_xy [m], @p step_theta [rad] around @p q (q itself left out).
+std::vector<Pose2> latticeAround(const Pose2& q, double step_xy, double step_theta)
+{
+  std::vector<Pose2> poses;
+  for (int a = -1; a <= 1; ++a)
+  {
+    for (int b = -1; b <= 1; ++b)
+    {
+      for (int c = -1; c <= 1; ++c)
+      {
+        if (a != 0 || b != 0 || c != 0)
+        {
+          poses.emplace_back(q.x + a * step_xy, q.y + b * step_xy, wrapAngle(q.theta + c * step_theta));
+        }
+      }
+    }
+  }
+  return poses;
+}
+
 /// @p candidate moved to the best pose polished from the 26 poses of a lattice @p step_xy [m],
 /// @p step_theta [rad] around it, while that is better and half a step away or more and the
 /// candidate is near an edge of the cost (nearAnEdge()), kNearBasinRounds times at most.
@@ -51,24 +72,12 @@ void settleInNearBasin(const MapRayCaster& map, const std::vector<Reading>& read
        ++round)
   {
     Candidate best = candidate;
-    for (int a = -1; a <= 1; ++a)
+    for (const Pose2& start : latticeAround(candidate.pose, step_xy, step_theta))
     {
-      for (int b = -1; b <= 1; ++b)
+      Candidate polished = polishedFrom(map, readings, settings, candidate, start);
+      if (betterCandidate(polished, best))
       {
-        for (int c = -1; c <= 1; ++c)
-        {
-          if (a == 0 && b == 0 && c == 0)
-          {
-            continue;
-          }
-          const Pose2& q = candidate.pose;
-          const Pose2 start(q.x + a * step_xy, q.y + b * step_xy, wrapAngle(q.theta + c * step_theta));
-          Candidate polished = polishedFrom(map, readings, settings, candidate, start);
-          if (betterCandidate(polished, best))
-          {
-            best = std::move(polished);
-          }
-        }
+        best = std::move(polished);
       }
     }
     if (!betterCandidate(best, candidate))
@@ -86,6 +95,7 @@ void settleInNearBasin(const MapRayCaster& map, const std::vector<Reading>& read
     }
   }
 }
+
 /// Widens the covariance of an exact @p candidate near an edge of the cost (nearAnEdge()) to cover the exact places
 /// polished from a lattice kTwinSteps steps (@p step_xy [m], @p step_theta [rad]) around it that tie it within the
 /// uniqueness margins (absorbTiedDuplicates()): the engine returns one of such twins, and the readings cannot tell
@@ -100,25 +110,12 @@ void absorbExactTwins(const MapRayCaster& map, const std::vector<Reading>& readi
     return;
   }
   std::vector<Candidate> twins;
-  for (int a = -1; a <= 1; ++a)
+  for (const Pose2& start : latticeAround(candidate.pose, kTwinSteps * step_xy, kTwinSteps * step_theta))
   {
-    for (int b = -1; b <= 1; ++b)
+    Candidate twin = polishedFrom(map, readings, settings, candidate, start);
+    if (twin.rms_residual < kExactRms)
     {
-      for (int c = -1; c <= 1; ++c)
-      {
-        if (a == 0 && b == 0 && c == 0)
-        {
-          continue;
-        }
-        const Pose2& q = candidate.pose;
-        const Pose2 start(q.x + kTwinSteps * a * step_xy, q.y + kTwinSteps * b * step_xy,
-                          wrapAngle(q.theta + kTwinSteps * c * step_theta));
-        Candidate twin = polishedFrom(map, readings, settings, candidate, start);
-        if (twin.rms_residual < kExactRms)
-        {
-          twins.push_back(std::move(twin));
-        }
-      }
+      twins.push_back(std::move(twin));
     }
   }
   std::vector<Candidate> kept{ candidate };

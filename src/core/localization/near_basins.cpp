@@ -122,6 +122,7 @@ void absorbExactTwins(const MapRayCaster& map, const std::vector<Reading>& readi
   absorbTiedDuplicates(twins, options.uniqueness_distance, options.uniqueness_angle, settings.noise_sigma, kept);
   candidate.covariance = kept.front().covariance;
 }
+
 }  // namespace
 
 void settleInNearBasins(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,

@@ -104,18 +104,21 @@ Candidate placeInLeaf(const MapRayCaster& map, const std::vector<Reading>& readi
   return place;
 }
 
-/// True when pass 0 leaves @p box to the places found so far: one lies in it, or the continuum of
-/// one that accountsFor() it (@p target, @p settled [m]) reaches it. Pass 1 searches such a leaf, @p rival then the
-/// better of itself and that place: the place found first in a region can be a local optimum of the residual while an
-/// exact one lies a leaf away (in a corridor, 4 of 4 readings with an rms of 11 mm, 85 cm from the truth's 0; in the
-/// warehouse, a ray grazing a corner, 45 um 21 cm from it).
+/// True when pass 0 leaves @p box to the places found so far: one lies in it, or the continuum of an exact one that
+/// accountsFor() it (@p target, @p settled [m]) reaches it. Short of exact, a place found can be a local optimum beside
+/// the exact one (verification seed 814, 4 cones: a place of 6.8 mm 10 deg from the exact truth, its heading's sd of
+/// 5.3 deg reaching the truth's leaf, which waited for pass 1 and was never searched). Pass 1 searches such a leaf,
+/// @p rival then the better of itself and that place: the place found first in a region can be a local optimum of the
+/// residual while an exact one lies a leaf away (in a corridor, 4 of 4 readings with an rms of 11 mm, 85 cm from the
+/// truth's 0; in the warehouse, a ray grazing a corner, 45 um 21 cm from it).
 bool leftToFound(Accounting& found, const PoseBox& box, int pass, int target, double settled, Candidate& rival)
 {
   const Candidate* holder = found.holder(box);
   const Candidate* near = holder != nullptr ? holder : found.continuumAt(box);
   if (near == nullptr || pass == 0)
   {
-    return near != nullptr && (holder != nullptr || accountsFor(*near, target, settled));
+    return near != nullptr &&
+           (holder != nullptr || (accountsFor(*near, target, settled) && near->rms_residual < kExactRms));
   }
   if (rival.inliers < 0 || betterCandidate(*near, rival))
   {

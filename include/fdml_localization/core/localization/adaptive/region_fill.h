@@ -44,12 +44,11 @@ namespace core
  *        ..., further leaves only while no place was found in the region, when their centre
  *        explains within two readings of the consensus or that agreement reaches it), then, while the
  *        budget lasts, the leaves left: of regions holding a place, those a place found by this
- *        fill lies in, and those on the continuum of a candidate or place found whose RMS is
- *        within @p settings' noise_sigma and the best candidate's (or exact, where that is; a
- *        continuum missing the readings by more holds no leaf back; a place in a leaf on a continuum joins
- *        only when better than its candidate or place: the first place found in a region can be
- *        a local optimum of the residual).
- *        At least 64 leaves, more while their box tests stay within 100,000, and 50,000 more for
+ *        fill lies in, and those on the continuum of a candidate whose RMS is within
+ *        @p settings' noise_sigma and the best candidate's (or exact, where that is), or of an
+ *        exact place found (a continuum missing the readings by more holds no leaf back; a place in a leaf on a
+ * continuum joins only when better than its candidate or place: the first place found in a region can be a local
+ * optimum of the residual). At least 64 leaves, more while their box tests stay within 100,000, and 50,000 more for
  *        leaves whose bound exceeds the best place found (the answer then provably incomplete).
  *        Each leaf is searched through its sub-boxes (searchLeafForPlace()), the best centre
  *        refined with @p settings scaled to its sub-box, and again for one reading more while its

@@ -27,6 +27,15 @@ constexpr std::size_t kFillDeepBeam = 4;
 /// Noisy readings leave every place above it: the search then stops as before.
 constexpr double kNoiseFreeFraction = 0.1;
 
+/// True when @p place ends a leaf's search for @p target readings: it reaches the target, exact or not nearly so
+/// (kNoiseFreeFraction of @p settings' noise_sigma).
+bool endsLeafSearch(const Candidate& place, int target, const RefinementSettings& settings)
+{
+  const bool nearly_exact =
+      place.rms_residual >= kExactRms && place.rms_residual < kNoiseFreeFraction * settings.noise_sigma;
+  return netConsensus(place) >= target && !nearly_exact;
+}
+
 /// Deepest sub-boxes a screen verifies (screenLeaf()).
 constexpr std::size_t kScreenVerified = 8;
 
@@ -180,9 +189,7 @@ Candidate searchLeafForPlace(const MapRayCaster& map, const LeafBox& leaf, const
   const auto refine = [&](const PoseBox& box, const Candidate& from) {
     const Candidate found = refinedNear(map, readings, options, settings, leaf.box, box, from);
     refined = betterCandidate(found, refined) ? found : refined;
-    const bool near_exact =
-        refined.rms_residual >= kExactRms && refined.rms_residual < kNoiseFreeFraction * settings.noise_sigma;
-    return netConsensus(refined) >= target && !near_exact;
+    return endsLeafSearch(refined, target, settings);
   };
   for (int depth = 1; !level.empty(); ++depth)
   {

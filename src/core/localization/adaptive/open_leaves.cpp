@@ -80,8 +80,19 @@ bool rankedBefore(const OpenLeaf& a, const OpenLeaf& b)
   return betterCandidate(a.centre, b.centre);
 }
 
-/// Ranks @p open within each of its @p regions (rankedBefore()) and sorts it by rank.
-void rankWithinRegions(int regions, std::vector<OpenLeaf>& open)
+/// The tier of @p o in the round robin (rankWithinRegions()): 0 for its region's best leaf, else the readings of
+/// @p target its centre misses at the leaf's own scale (its agreement).
+int roundRobinTier(const OpenLeaf& o, int target)
+{
+  return o.rank == 0 ? 0 : std::max(0, target - o.agreement.within);
+}
+
+/// Ranks @p open within each of its @p regions (rankedBefore()) and sorts it into the round robin: every region's best
+/// leaf, then tier by tier (roundRobinTier(): the leaves agreeing with @p target at their own scale, then those missing
+/// one reading, ...), by rank within a tier. With 4 cones driving in a building, 8,598 leaves in 159 regions reached 4;
+/// the truth's leaf, agreeing with 3, ranked 22nd in its region, and the fill's budget ran out after 1,558 leaves
+/// before that rank's round (verification seed 820); 1,045 leaves agree with 3 or more, and tiered it is reached.
+void rankWithinRegions(int regions, int target, std::vector<OpenLeaf>& open)
 {
   std::stable_sort(open.begin(), open.end(), rankedBefore);
   std::vector<int> ranked(static_cast<std::size_t>(regions), 0);
@@ -89,7 +100,10 @@ void rankWithinRegions(int regions, std::vector<OpenLeaf>& open)
   {
     o.rank = ranked[static_cast<std::size_t>(o.region)]++;
   }
-  std::stable_sort(open.begin(), open.end(), [](const OpenLeaf& a, const OpenLeaf& b) { return a.rank < b.rank; });
+  std::stable_sort(open.begin(), open.end(), [target](const OpenLeaf& a, const OpenLeaf& b) {
+    const int tier_a = roundRobinTier(a, target), tier_b = roundRobinTier(b, target);
+    return tier_a != tier_b ? tier_a < tier_b : a.rank < b.rank;
+  });
 }
 
 }  // namespace
@@ -170,7 +184,7 @@ std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<Leaf
     open.push_back(std::move(o));
   }
   screenOpenLeaves(map, readings, options, target, open);
-  rankWithinRegions(regions, open);
+  rankWithinRegions(regions, target, open);
   return open;
 }
 

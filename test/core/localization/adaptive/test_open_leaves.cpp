@@ -1,6 +1,7 @@
 // Which leaves the region fill searches (open_leaves.h): a candidate holds a leaf back only when
 // it reaches the fill's target with an RMS within the noise (twentieth round, verification seeds
-// 802 and 805), and one short of exact has it searched first, as its own place (seed 810).
+// 802 and 805), and one short of exact has it searched first, as its own place (seed 810); the
+// leaves agreeing with the target come before the next rank of other regions (seed 820).
 #include "fdml_localization/core/localization/adaptive/open_leaves.h"
 
 #include "localizer_test_utils.h"
@@ -104,6 +105,43 @@ TEST_F(OpenLeavesTest, AnExactContinuumHoldsTheLeafBackOneShortOfExactSearchesIt
   EXPECT_EQ(beyond.front().rival.inliers, 6);  // a place there still has to beat it
   EXPECT_FALSE(beyond.front().own);
   EXPECT_EQ(beyond.front().centre.inliers, 6);  // ranked now, searched in pass 0
+}
+
+TEST_F(OpenLeavesTest, LeavesAgreeingWithTheTargetComeBeforeTheNextRankOfOtherRegions)
+{
+  // Region A: three 1 cm leaves in a row at the pose the readings were taken from (each agrees
+  // with all 6 readings at its scale); region B: four in a row at another free pose.
+  std::mt19937_64 rng(11);
+  const Pose2 p = test::randomFreePose(*map, rng, 0.3);
+  const auto leafAt = [](const Pose2& c, std::int64_t ix) {
+    LeafBox leaf;
+    leaf.box = PoseBox{ c.x - 0.005, c.x + 0.005, c.y - 0.005, c.y + 0.005, c.theta - 0.005, c.theta + 0.005 };
+    leaf.count = 6;
+    leaf.ix = ix;
+    return leaf;
+  };
+  leaves.clear();
+  for (int j = 0; j < 3; ++j)
+  {
+    leaves.push_back(leafAt(Pose2(q.x + 0.01 * j, q.y, q.theta), j));
+  }
+  for (int j = 0; j < 4; ++j)
+  {
+    leaves.push_back(leafAt(Pose2(p.x + 0.01 * j, p.y, p.theta), 100 + j));
+  }
+  const std::vector<OpenLeaf> order = open({});
+  ASSERT_EQ(order.size(), 7u);
+  const auto inA = [&](const OpenLeaf& o) { return o.leaf->box.x0 < q.x + 0.03 && o.leaf->box.x1 > q.x - 0.01; };
+  for (const OpenLeaf& o : order)
+  {
+    // Preconditions: A's leaves agree with the target at their scale, B's do not.
+    ASSERT_EQ(o.agreement.within >= 6, inA(o)) << o.leaf->box.x0 << " " << o.agreement.within;
+  }
+  // Every region's best first, then A's two others (they agree), then B's three others: round
+  // robin by rank alone would take B's second before A's third.
+  EXPECT_EQ(order[0].rank + order[1].rank, 0);
+  EXPECT_TRUE(inA(order[2]) && inA(order[3]));
+  EXPECT_FALSE(inA(order[4]) || inA(order[5]) || inA(order[6]));
 }
 
 }  // namespace

@@ -40,7 +40,8 @@ namespace core
  *        first the leaves whose bound exceeds the consensus (highest first; a place
  *        there raises it), then round robin over their connected regions (26 neighbours,
  *        @p theta_cells heading cells around the circle: every region's best leaf by its centre's
- *        agreement at the leaf's scale (closerAgreement()) then by its centre, then its second,
+ *        agreement at the leaf's scale (closerAgreement()) then by its centre, then, tier by tier
+ *        (agreeing with the consensus at the leaf's scale, missing one reading, ...), its second,
  *        ..., further leaves only while no place was found in the region, when their centre
  *        explains within two readings of the consensus or that agreement reaches it), then, while the
  *        budget lasts, the leaves left: of regions holding a place, those a place found by this

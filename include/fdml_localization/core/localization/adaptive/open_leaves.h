@@ -65,8 +65,7 @@ bool screenedOut(const MapRayCaster& map, const std::vector<Reading>& readings, 
 /// leaves whose centre agrees with @p target at the leaf's scale, then those missing one reading, ..., within a tier
 /// the second best of every region, then the third, ...; the best first within a rank), the best agreeing best at the
 /// leaf's own scale (closerAgreement()), then the best centre. The centre of a leaf left to an exact rival that
-/// accountsFor() it
-/// (@p settled [m]) is verified when it is searched. A region's place may lie far from its leaves'
+/// accountsFor() it (@p settled [m]) is verified when it is searched. A region's place may lie far from its leaves'
 /// centres, on a large map many separate regions reach the consensus (alike rooms, alcoves), and a continuum's
 /// candidate (sd of metres along a corridor) can be an approximate place while an exact one lies on it.
 std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<LeafBox>& leaves, int target,

@@ -69,10 +69,11 @@ constexpr int kPromisingSlack = 2;
  *        first sub-box of the beam is refined too when its centre explains within two readings
  *        of the target within the bands (with readings of 11 m, the centre of the truth's 4.7 cm,
  *        0.35 deg sub-box explains 2 of 5 within eps and 3 within the bands). A refinement is kept when
- *        it stays within two leaves of its start; the search stops at a pose reaching the target, exact or with an RMS
- * of a tenth of noise_sigma or more (near noise-free readings, an exact place can lie a few millimetres from a place
- * short of it). Where rays graze corners or short no-return ranges shape it, a place can be a few centimetres or
- * millimetres wide: a lattice of the whole leaf misses it.
+ *        it stays within two leaves of its start; the search stops at a pose in the leaf (or within half its size)
+ * reaching the target, exact or with an RMS of a tenth of noise_sigma or more (near noise-free readings, an exact place
+ * can lie a few millimetres from a place short of it; a refinement that leaves the leaf found another leaf's place).
+ * Where rays graze corners or short no-return ranges shape it, a place can be a few centimetres or millimetres wide: a
+ * lattice of the whole leaf misses it.
  * @param centre the leaf's centre, verified (the answer when nothing better is found)
  * @param box_tests counted down by the box tests made (the search of a leaf is never cut)
  */

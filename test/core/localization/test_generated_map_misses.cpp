@@ -196,9 +196,9 @@ const PastMiss kPastMisses[] = {
     "-2.8972757501539705) half angle 0.23561944901923448" },
   // Twenty-third round (`--seed 826 --k 4:6 --random-maps 2 --buildings 2`, map 1, a random 70-gon):
   // 5 rays driving, 1,182 open leaves reaching 5. The truth's leaf was searched, but its first
-  // sub-box refined to a place of 6.8 mm 16 cm outside the leaf, which ended the search, and the
-  // voxel engine missed the truth. Only a place in the leaf ends its search now.
-  { "OnlyAPlaceInTheLeafEndsItsSearch", 2, 2, 826,
+  // sub-box refined to a place of 6.8 mm 10 cm past the 9 cm leaf's edge, which ended the search,
+  // and the voxel engine missed the truth. Only a place within half a leaf ends its search now.
+  { "OnlyAPlaceNearTheLeafEndsItsSearch", 2, 2, 826,
     "driving map 1 k 5 exact truth (-0.024208172766836622, 0.43729046433819052, "
     "1.6216137263547736)" },
 };

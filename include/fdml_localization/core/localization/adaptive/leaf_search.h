@@ -71,7 +71,7 @@ constexpr int kPromisingSlack = 2;
  *        0.35 deg sub-box explains 2 of 5 within eps and 3 within the bands). A refinement is kept when
  *        it stays within two leaves of its start; the search stops at a pose in the leaf (or within half its size)
  * reaching the target, exact or with an RMS of a tenth of noise_sigma or more (near noise-free readings, an exact place
- * can lie a few millimetres from a place short of it; a refinement that leaves the leaf found another leaf's place).
+ * can lie a few millimetres from a place short of it; a refinement that goes further found another leaf's place).
  * Where rays graze corners or short no-return ranges shape it, a place can be a few centimetres or millimetres wide: a
  * lattice of the whole leaf misses it.
  * @param centre the leaf's centre, verified (the answer when nothing better is found)

@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <random>
@@ -89,6 +90,50 @@ TEST(ConeBoxTest, NoFalseNegativeAgainstSampledPoses)
     }
   }
   EXPECT_GT(explained_boxes, 500);  // the test exercises the box test
+}
+
+TEST(ConeBoxTest, AnEdgeNearerInEveryConePrunesButNeverAPoseThatExplains)
+{
+  // Exact readings (tolerance 0) from a pose of a small box: the box always stays. Readings
+  // longer than every sampled pose of the box sees (its cone meets a wall nearer): the box goes
+  // more often than not, an edge inside every pose's cone being nearer.
+  std::mt19937_64 rng(19);
+  std::uniform_real_distribution<double> unit(0.0, 1.0), off(-0.2, 0.2);
+  int too_long = 0, pruned = 0;
+  for (const char* name : { "maps/office.poly", "maps/apartment.poly" })
+  {
+    const auto map = test::loadMap(name);
+    for (int trial = 0; trial < 4000; ++trial)
+    {
+      const Pose2 q = test::randomFreePose(*map, rng, 0.0);
+      const double size = 0.002 + 0.1 * unit(rng);
+      const PoseBox box{ q.x - size * unit(rng), q.x + size * unit(rng),     q.y - size * unit(rng),
+                         q.y + size * unit(rng), q.theta - size * unit(rng), q.theta + size * unit(rng) };
+      Reading r;
+      r.offset = Pose2(off(rng), off(rng), wrapAngle(16.0 * off(rng)));
+      r.half_angle = trial % 7 == 0 ? kMaxConeHalfAngle : 0.05 + 0.6 * unit(rng);
+      const Pose2 sensor = compose(q, r.offset);
+      r.range = coneRange(*map, sensor, r.half_angle);
+      if (!map->isFree(sensor.position()) || !std::isfinite(r.range))
+      {
+        continue;
+      }
+      ASSERT_TRUE(readingMayExplain(*map, r, box, 0.0)) << name << " trial " << trial;
+      r.range += 0.3 + unit(rng);
+      double longest = 0.0;
+      for (int s = 0; s < 100; ++s)
+      {
+        longest = std::max(longest, coneRange(*map, compose(sampleIn(box, rng), r.offset), r.half_angle));
+      }
+      if (longest < r.range - 0.1)
+      {
+        ++too_long;
+        pruned += readingMayExplain(*map, r, box, 0.05) ? 0 : 1;
+      }
+    }
+  }
+  EXPECT_GT(too_long, 2000);
+  EXPECT_GT(pruned, too_long / 2) << pruned << " of " << too_long;
 }
 
 TEST(ConeBoxTest, ZeroHalfAngleIsTheRayArc)

@@ -1,5 +1,7 @@
 #include "fdml_localization/core/localization/adaptive/adaptive_search.h"
 
+#include "fdml_localization/core/geometry/cone_cast.h"
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -75,6 +77,51 @@ bool oneEdgeStopsEveryRay(const MapRayCaster& map, const Box2& sensors, double a
   }
   return true;
 }
+
+/**
+ * True when every pose of @p box sees a map edge point inside its cone nearer than @p limit [m], so
+ * that no pose explains @p reading (a cone, half_angle > 0). The headings every pose's cone covers
+ * form a window of width 2 a - (t1 - t0); the sensor lies within rho of the centre's sensor c. A
+ * point q at least r_min = rho / sin(w / 4) from c is seen from every sensor position within w / 4
+ * of its direction from c, so one inside the centre's sector of half-angle w / 4 (the window less
+ * that slack on each side) lies in every pose's cone, and at most |q - c| + rho from its sensor.
+ */
+bool coneCertainlyNearer(const MapRayCaster& map, const Reading& reading, const PoseBox& box, double limit)
+{
+  const double window = 2.0 * std::min(reading.half_angle, kMaxConeHalfAngle) - (box.t1 - box.t0);
+  if (!(window > 0.0))
+  {
+    return false;
+  }
+  const Vec2 g(reading.offset.x, reading.offset.y);
+  const double rho = 0.5 * std::hypot(box.x1 - box.x0, box.y1 - box.y0) + 0.5 * g.norm() * (box.t1 - box.t0);
+  const double slack = 0.25 * window;
+  const double r_min = rho / std::sin(slack);
+  const double reach = (limit - rho) * (1.0 - 1e-12);
+  if (!(r_min < reach))
+  {
+    return false;
+  }
+  const double mid = 0.5 * (box.t0 + box.t1);
+  const double c = std::cos(mid);
+  const double s = std::sin(mid);
+  const Pose2 centre(0.5 * (box.x0 + box.x1) + c * g.x() - s * g.y(), 0.5 * (box.y0 + box.y1) + s * g.x() + c * g.y(),
+                     mid + reading.offset.theta);
+  const double nearest = coneRange(map, centre, slack, reach);
+  return nearest >= r_min && nearest < reach;
+}
+
+/// True when every pose of @p box has a map edge point in its reading's cone (its ray) nearer
+/// than @p limit [m]: one edge stops every ray along the axis (a cone's range is no longer), or, for
+/// a cone, coneCertainlyNearer().
+bool nearerEverywhere(const MapRayCaster& map, const Reading& reading, const PoseBox& box, const Box2& sensors,
+                      double limit)
+{
+  const double t0 = box.t0 + reading.offset.theta;
+  const double t1 = box.t1 + reading.offset.theta;
+  return oneEdgeStopsEveryRay(map, sensors, t0, t1, limit) ||
+         (reading.half_angle > 0.0 && coneCertainlyNearer(map, reading, box, limit));
+}
 }  // namespace
 
 Box2 rotatedArcBounds(const Vec2& v, double t0, double t1)
@@ -126,21 +173,21 @@ bool readingMayExplain(const MapRayCaster& map, const Reading& reading, const Po
   positions.extend(Vec2(box.x0, box.y0));
   positions.extend(Vec2(box.x1, box.y1));
   const Pose2& g = reading.offset;
+  const Box2 sensors = sweep(positions, rotatedArcBounds(Vec2(g.x, g.y), box.t0, box.t1), 0.0);
   // The sensor must be in free space somewhere in the box (for a sensor at the base origin the
   // caller's robot-position test already says so).
-  if ((g.x != 0.0 || g.y != 0.0) &&
-      outsideFreeSpace(map, sweep(positions, rotatedArcBounds(Vec2(g.x, g.y), box.t0, box.t1), 0.0)))
+  if ((g.x != 0.0 || g.y != 0.0) && outsideFreeSpace(map, sensors))
   {
     return false;
   }
   if (!std::isfinite(reading.range))
   {
-    // A no-return reading agrees when nothing is nearer than max_range - tau (a cone's nearest
-    // point is no farther than its axis's hit, so the axis decides for a cone too).
-    const Box2 sensors = sweep(positions, rotatedArcBounds(Vec2(g.x, g.y), box.t0, box.t1), 0.0);
-    return !oneEdgeStopsEveryRay(map, sensors, box.t0 + g.theta, box.t1 + g.theta, reading.max_range - range_tolerance);
+    // A no-return reading agrees when nothing is nearer than max_range - tau.
+    return !nearerEverywhere(map, reading, box, sensors, reading.max_range - range_tolerance);
   }
-  return map.grid().anySegmentInBox(sweep(positions, hitArcBounds(reading, box.t0, box.t1), range_tolerance));
+  // Some edge point where the reading ends, and not something nearer for every pose.
+  return map.grid().anySegmentInBox(sweep(positions, hitArcBounds(reading, box.t0, box.t1), range_tolerance)) &&
+         !nearerEverywhere(map, reading, box, sensors, reading.range - range_tolerance);
 }
 
 int boxConsensusBound(const MapRayCaster& map, const std::vector<Reading>& readings, double range_tolerance,

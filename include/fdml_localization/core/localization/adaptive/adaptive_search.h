@@ -103,7 +103,9 @@ struct AdaptiveSearchResult
 };
 
 /// The conservative per-reading box test (exposed for tests): false only when the reading
-/// provably cannot be explained by any pose in @p box.
+/// provably cannot be explained by any pose in @p box: the sensor outside free space, no map
+/// edge where the reading ends (within @p range_tolerance [m]), or an edge nearer in every pose's
+/// ray or cone (docs/METHOD.md, the adaptive engine and cone readings).
 bool readingMayExplain(const MapRayCaster& map, const Reading& reading, const PoseBox& box, double range_tolerance);
 
 /**

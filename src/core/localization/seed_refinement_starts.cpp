@@ -53,6 +53,25 @@ void Refiner::fineFrom(const Pose2& start, const std::vector<bool>& use)
   }
 }
 
+/// Rays this close in heading [rad] on the robot are one sensor's (driving, successive readings)
+/// or alike: they cross an occlusion edge together.
+constexpr double kParallelRays = 0.035;
+
+bool parallelRays(const Reading& a, const Reading& b)
+{
+  return std::abs(wrapAngle(a.offset.theta - b.offset.theta)) < kParallelRays;
+}
+
+std::vector<bool> Refiner::withoutParallel(int drop) const
+{
+  std::vector<bool> use = finiteInliers(drop);
+  for (std::size_t i = 0; i < readings_.size(); ++i)
+  {
+    use[i] = use[i] && !parallelRays(readings_[i], readings_[static_cast<std::size_t>(drop)]);
+  }
+  return use;
+}
+
 /// The readings to leave out in one escape round: the worst one, then those passing nearest a
 /// vertex; empty when fewer than 4 finite inliers remain.
 std::vector<int> Refiner::escapeTries() const
@@ -85,8 +104,10 @@ std::vector<int> Refiner::escapeTries() const
 
 /// The ray-cast cost is only piecewise smooth: a reading whose ray crosses an occlusion edge
 /// between here and the optimum can hold the polish in a false minimum. Leave out, one at a
-/// time, the readings passing nearest to a vertex and the worst one, and keep the result when
-/// the consensus improves.
+/// time, the readings passing nearest to a vertex and the worst one, each then with the readings
+/// parallel to it, and keep the result when the consensus improves (verification seed 842: two
+/// front rays of a robot driving crossed a wall's step 1.8 cm deep together, and leaving out either
+/// alone kept the polish 1.75 deg from the exact truth).
 void Refiner::escapes()
 {
   for (int attempt = 0;
@@ -97,6 +118,12 @@ void Refiner::escapes()
     for (std::size_t j = 0; j < tries.size() && !improved; ++j)
     {
       improved = consider(polish(best_pose_, finiteInliers(tries[j]), 0.0));
+      // Its parallel siblings can hold the false minimum as firmly: left out with it.
+      const std::vector<bool> rest = withoutParallel(tries[j]);
+      if (!improved && countUsed(rest) >= 3 && countUsed(rest) + 1 < countUsed(finiteInliers(-1)))
+      {
+        improved = consider(polish(best_pose_, rest, 0.0));
+      }
     }
     if (!improved)
     {

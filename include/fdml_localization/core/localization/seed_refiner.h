@@ -68,6 +68,8 @@ private:
   void fineFrom(const Pose2& start, const std::vector<bool>& use);
   /// The finite-range inliers of the best pose, without reading @p drop (-1: none).
   std::vector<bool> finiteInliers(int drop) const;
+  /// finiteInliers() without reading @p drop nor the others pointing its way (parallelRays()).
+  std::vector<bool> withoutParallel(int drop) const;
   std::vector<int> escapeTries() const;
 
   const MapRayCaster& map_;

@@ -107,7 +107,7 @@ bool coneCertainlyNearer(const MapRayCaster& map, const Reading& reading, const 
   const double s = std::sin(mid);
   const Pose2 centre(0.5 * (box.x0 + box.x1) + c * g.x() - s * g.y(), 0.5 * (box.y0 + box.y1) + s * g.x() + c * g.y(),
                      mid + reading.offset.theta);
-  const double nearest = coneRange(map, centre, slack, reach);
+  const double nearest = coneRange(map, centre, 0.5 * window - slack, reach);
   return nearest >= r_min && nearest < reach;
 }
 

@@ -117,10 +117,11 @@ void Refiner::escapes()
     bool improved = false;
     for (std::size_t j = 0; j < tries.size() && !improved; ++j)
     {
-      improved = consider(polish(best_pose_, finiteInliers(tries[j]), 0.0));
+      const std::vector<bool> alone = finiteInliers(tries[j]);
+      improved = consider(polish(best_pose_, alone, 0.0));
       // Its parallel siblings can hold the false minimum as firmly: left out with it.
-      const std::vector<bool> rest = withoutParallel(tries[j]);
-      if (!improved && countUsed(rest) >= 3 && countUsed(rest) + 1 < countUsed(finiteInliers(-1)))
+      const std::vector<bool> rest = improved ? alone : withoutParallel(tries[j]);
+      if (countUsed(rest) >= 3 && countUsed(rest) < countUsed(alone))
       {
         improved = consider(polish(best_pose_, rest, 0.0));
       }

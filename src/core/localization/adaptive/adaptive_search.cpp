@@ -102,12 +102,8 @@ bool coneCertainlyNearer(const MapRayCaster& map, const Reading& reading, const 
   {
     return false;
   }
-  const double mid = 0.5 * (box.t0 + box.t1);
-  const double c = std::cos(mid);
-  const double s = std::sin(mid);
-  const Pose2 centre(0.5 * (box.x0 + box.x1) + c * g.x() - s * g.y(), 0.5 * (box.y0 + box.y1) + s * g.x() + c * g.y(),
-                     mid + reading.offset.theta);
-  const double nearest = coneRange(map, centre, 0.5 * window - slack, reach);
+  const Pose2 centre(0.5 * (box.x0 + box.x1), 0.5 * (box.y0 + box.y1), 0.5 * (box.t0 + box.t1));
+  const double nearest = coneRange(map, compose(centre, reading.offset), 0.5 * window - slack, reach);
   return nearest >= r_min && nearest < reach;
 }
 

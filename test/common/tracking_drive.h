@@ -35,42 +35,38 @@ struct DriveBatch
 class Drive
 {
 public:
-  Drive(std::unique_ptr<core::Simulation> sim, int k, int stride) : sim_(std::move(sim)), k_(k), stride_(stride)
+  /// @p per_reading: a batch may form after any reading, as the node forms them (readings of one
+  /// step one by one); otherwise only after a whole simulation step.
+  Drive(std::unique_ptr<core::Simulation> sim, int k, int stride, bool per_reading = false)
+    : sim_(std::move(sim)), k_(k), stride_(stride), per_reading_(per_reading)
   {}
 
   /// Steps until the next batch is due; false after @p max_time simulated seconds.
   bool next(DriveBatch* batch, double max_time)
   {
-    core::StepOutput out;
-    while (sim_->time() < max_time)
+    while (!pending_.empty() || sim_->time() < max_time)
     {
-      sim_->step(&out);
-      for (const core::SimReading& r : out.readings)
+      if (pending_.empty())
       {
-        const auto& sensor = sim_->config().sensors[r.sensor];
-        if (r.dropped || std::isnan(r.range) || r.range == -core::kInf)
+        core::StepOutput out;
+        sim_->step(&out);
+        for (const core::SimReading& r : out.readings)
         {
-          continue;
+          pending_.push_back(Pending{ r, sim_->odomPose(), sim_->truePose() });
         }
-        Entry e;
-        e.odom_base = sim_->odomPose();
-        e.truth_base = sim_->truePose();
-        e.sensor_in_odom = core::compose(e.odom_base, sensor.mount);
-        e.range = r.range;
-        e.max_range = sensor.max_range;
-        e.half_angle = 0.5 * sensor.fov;  // the simulator reads a cone when fov > 0
-        e.obstacle = r.kind == core::SceneHit::Kind::Obstacle;
-        e.time = r.time;
-        window_.push_back(e);
-        ++since_batch_;
       }
-      while (static_cast<int>(window_.size()) > k_)
+      while (!pending_.empty())
       {
-        window_.pop_front();
+        take(pending_.front());
+        pending_.pop_front();
+        if (per_reading_ && due())
+        {
+          fill(batch);
+          return true;
+        }
       }
-      if (static_cast<int>(window_.size()) == k_ && since_batch_ >= stride_)
+      if (!per_reading_ && due())
       {
-        since_batch_ = 0;
         fill(batch);
         return true;
       }
@@ -90,6 +86,49 @@ private:
     double range = 0.0, max_range = 0.0, half_angle = 0.0, time = 0.0;
     bool obstacle = false;
   };
+
+  struct Pending
+  {
+    core::SimReading reading;
+    core::Pose2 odom_base, truth_base;
+  };
+
+  /// Adds @p p to the window (the newest k readings) unless it was lost.
+  void take(const Pending& p)
+  {
+    const core::SimReading& r = p.reading;
+    const auto& sensor = sim_->config().sensors[r.sensor];
+    if (r.dropped || std::isnan(r.range) || r.range == -core::kInf)
+    {
+      return;
+    }
+    Entry e;
+    e.odom_base = p.odom_base;
+    e.truth_base = p.truth_base;
+    e.sensor_in_odom = core::compose(e.odom_base, sensor.mount);
+    e.range = r.range;
+    e.max_range = sensor.max_range;
+    e.half_angle = 0.5 * sensor.fov;  // the simulator reads a cone when fov > 0
+    e.obstacle = r.kind == core::SceneHit::Kind::Obstacle;
+    e.time = r.time;
+    window_.push_back(e);
+    ++since_batch_;
+    while (static_cast<int>(window_.size()) > k_)
+    {
+      window_.pop_front();
+    }
+  }
+
+  /// True (and counting restarts) when the window is full and stride readings came since the last batch.
+  bool due()
+  {
+    if (static_cast<int>(window_.size()) < k_ || since_batch_ < stride_)
+    {
+      return false;
+    }
+    since_batch_ = 0;
+    return true;
+  }
 
   void fill(DriveBatch* batch) const
   {
@@ -113,8 +152,10 @@ private:
   std::unique_ptr<core::Simulation> sim_;
   int k_;
   int stride_;
+  bool per_reading_;
   int since_batch_ = 0;
   std::deque<Entry> window_;
+  std::deque<Pending> pending_;
 };
 
 /// The simulation of @p config on @p map; throws std::invalid_argument naming the config's

@@ -97,7 +97,7 @@ OfficeRun driveOffice(std::uint64_t seed, double duration)
     {
       const core::TrackState state = tracker.state();
       if (state == core::TrackState::Empty || state == core::TrackState::Lost ||
-          (tracker.failedUpdates() >= 40 && since_global >= 40))
+          (tracker.failedUpdates() >= 40 && since_global >= 40) || tracker.awaitingConfirmation())
       {
         pending = global.localize(batch.readings);
         searched = batch.reference;

@@ -25,10 +25,11 @@ namespace core = fdml_localization::core;
 struct DriveBatch
 {
   std::vector<core::Reading> readings;
-  core::Pose2 reference;  ///< odometry pose of the base at the first reading
-  core::Pose2 truth;      ///< true pose of the base at the first reading (map)
-  double time = 0.0;      ///< simulated time of the newest reading [s]
-  int obstacle_hits = 0;  ///< readings that hit an unknown obstacle
+  core::Pose2 reference;    ///< odometry pose of the base at the first reading
+  core::Pose2 truth;        ///< true pose of the base at the first reading (map)
+  double start_time = 0.0;  ///< simulated time of the oldest reading [s]
+  double time = 0.0;        ///< simulated time of the newest reading [s]
+  int obstacle_hits = 0;    ///< readings that hit an unknown obstacle
 };
 
 /// See the file comment.
@@ -136,6 +137,7 @@ private:
     batch->obstacle_hits = 0;
     batch->reference = window_.front().odom_base;
     batch->truth = window_.front().truth_base;
+    batch->start_time = window_.front().time;
     batch->time = window_.back().time;
     for (const Entry& e : window_)
     {

@@ -1,0 +1,122 @@
+// Relocalizations replayed ROS-free, as the node runs them (used by HypothesisTrackerDemo and the
+// replay_relocalizations tool): the robot kidnapped at random, the tracker cleared, global
+// searches where SolverWorker::needsGlobalSearch runs them while relocalizing (seeded at the next
+// batch), until one hypothesis is clearly supported: what ~relocalize answers.
+#pragma once
+
+#include "fdml_localization/core/tracking/hypothesis_tracker.h"
+#include "tracking_drive.h"
+
+#include <algorithm>
+#include <memory>
+#include <string>
+
+namespace fdml_test
+{
+/// config/scenarios/demo.yaml with scenario seed @p seed: the robot turning in place at
+/// 0.8 rad/s, four narrow cones (front, left, back, right) at 1.6 Hz with 1 cm noise, three
+/// people walking at random and two chairs that are not in the map.
+inline core::ScenarioConfig demoScenario(std::uint64_t seed)
+{
+  core::ScenarioConfig c;
+  c.seed = seed;
+  c.step_rate = 50;
+  c.robot.radius = 0.18;
+  c.robot.motion = core::RobotMotion::Rotate;
+  c.robot.angular_speed = 0.8;
+  c.sensors = fourSensors(1.6, 8.0, 0.01);
+  for (core::SensorConfig& s : c.sensors)
+  {
+    s.fov = 0.04;
+  }
+  c.odometry.rate = 50;
+  c.odometry.translation_noise = 0.005;
+  c.odometry.rotation_noise = 0.005;
+  c.obstacles.push_back(walkers(3, 0.2, 0.5));
+  core::ObstacleGroupConfig chairs;
+  chairs.count = 2;
+  chairs.polygon = true;
+  chairs.vertices = { { -0.22, -0.22 }, { 0.22, -0.22 }, { 0.22, 0.22 }, { -0.22, 0.22 } };
+  c.obstacles.push_back(chairs);
+  return c;
+}
+
+/// What the relocalizations answered.
+struct ReplayAnswers
+{
+  int right = 0, wrong = 0, unanswered = 0;
+  double seconds = 0.0;  ///< summed time from the kidnap to the answer [s]
+  std::string first_wrong;
+};
+
+/// One relocalization after a kidnap at simulated time @p kidnapped [s]: searches and updates on
+/// the batches of readings all taken after it, for at most @p timeout [s].
+inline void relocalize(Drive& drive, double kidnapped, double timeout, core::HypothesisTracker& tracker,
+                       core::Localizer& global, ReplayAnswers* answers)
+{
+  tracker.clear();
+  core::Result found;
+  core::Pose2 searched;
+  bool pending = false;
+  int since_global = 0;
+  DriveBatch batch;
+  while (drive.next(&batch, kidnapped + timeout))
+  {
+    if (batch.start_time <= kidnapped)
+    {
+      continue;  // ~relocalize waits for k readings taken after the request
+    }
+    if (pending)
+    {
+      tracker.seed(found.candidates, searched, 0.0);
+      pending = false;
+    }
+    const core::TrackState state = tracker.state();
+    const bool stuck = tracker.failedUpdates() >= 40 && since_global >= 40;
+    if (state == core::TrackState::Empty || state == core::TrackState::Lost || stuck || tracker.awaitingConfirmation())
+    {
+      found = global.localize(batch.readings);
+      searched = batch.reference;
+      pending = !found.truncated;
+      since_global = 0;
+    }
+    since_global += tracker.hypotheses().empty() ? 0 : 1;
+    tracker.update(batch.readings, batch.reference);
+    int published = 0;
+    const std::string error = scorePublished(tracker, batch, &published, &answers->wrong);
+    answers->first_wrong = answers->first_wrong.empty() ? error : answers->first_wrong;
+    if (published > 0)
+    {
+      answers->right += error.empty() ? 1 : 0;
+      answers->seconds += batch.time - kidnapped;
+      return;
+    }
+  }
+  ++answers->unanswered;
+}
+
+/// @p kidnaps relocalizations (each allowed @p timeout [s]) in @p scenario on @p map, batches of
+/// @p k readings sliding by @p stride (formed per reading, as the node forms them), @p tracker
+/// and @p search the node's tracker and tracking global search.
+inline ReplayAnswers replayKidnaps(const core::ScenarioConfig& scenario, std::shared_ptr<const core::MapRayCaster> map,
+                                   int k, int stride, const core::TrackerOptions& tracker_options,
+                                   const core::LocalizerOptions& search, int kidnaps, double timeout)
+{
+  Drive drive(simulate(scenario, map), k, stride, true);
+  core::HypothesisTracker tracker(map, tracker_options);
+  core::Localizer global(map, search);
+  ReplayAnswers answers;
+  for (int n = 0; n < kidnaps; ++n)
+  {
+    core::Pose2 where;
+    std::string message;
+    if (!drive.sim().kidnapRandom(&where, &message))
+    {
+      throw std::runtime_error("kidnap: " + message);
+    }
+    relocalize(drive, drive.sim().time(), timeout, tracker, global, &answers);
+  }
+  return answers;
+}
+
+}  // namespace fdml_test

@@ -7,8 +7,8 @@
 #include "fdml_localization/core/tracking/hypothesis_tracker.h"
 #include "tracking_drive.h"
 
-#include <algorithm>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 namespace fdml_test

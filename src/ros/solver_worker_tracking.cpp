@@ -83,23 +83,6 @@ SolverWorker::Directive SolverWorker::takeDirective(const Job& job)
   return d;
 }
 
-bool SolverWorker::needsGlobalSearch(bool relocalizing) const
-{
-  const core::TrackState state = tracker_->state();
-  const bool empty_or_lost = state == core::TrackState::Empty || state == core::TrackState::Lost;
-  // Hypotheses that keep finding fixes are only ambiguous: another search would add aliases of
-  // them, never the evidence that tells them apart. Search again when none has found a fix for
-  // ~global_interval updates (some may still coast on odometry).
-  const bool stuck =
-      tracker_->failedUpdates() >= params_.global_interval && updates_since_global_ >= params_.global_interval;
-  // A place a search brought, otherwise clearly supported, waits for confirm_searches more.
-  if (relocalizing || solveMode(params_) == SolveMode::Continuous)
-  {
-    return empty_or_lost || stuck || tracker_->awaitingConfirmation();
-  }
-  return tracker_->awaitingConfirmation();
-}
-
 void SolverWorker::startGlobalSearch(const Job& job)
 {
   updates_since_global_ = 0;
@@ -215,7 +198,9 @@ std::string SolverWorker::stepTracker(const Directive& directive, const Job& job
       return applyHint(*directive.hint, job);
     }
     const std::string event = collectGlobalSearch();
-    if (!global_search_ && needsGlobalSearch(directive.relocalizing))
+    // New places while relocalizing (always in continuous mode); confirmations in any mode.
+    const bool searching = directive.relocalizing || solveMode(params_) == SolveMode::Continuous;
+    if (!global_search_ && tracker_->wantsGlobalSearch(searching, updates_since_global_, params_.global_interval))
     {
       startGlobalSearch(job);
     }

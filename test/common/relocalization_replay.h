@@ -1,6 +1,6 @@
 // Relocalizations replayed ROS-free, as the node runs them (used by HypothesisTrackerDemo and the
 // replay_relocalizations tool): the robot kidnapped at random, the tracker cleared, global
-// searches where SolverWorker::needsGlobalSearch runs them while relocalizing (seeded at the next
+// searches where the node runs them while relocalizing (HypothesisTracker::wantsGlobalSearch) (seeded at the next
 // batch), until one hypothesis is clearly supported: what ~relocalize answers.
 #pragma once
 
@@ -71,9 +71,7 @@ inline void relocalize(Drive& drive, double kidnapped, double timeout, core::Hyp
       tracker.seed(found.candidates, searched, 0.0);
       pending = false;
     }
-    const core::TrackState state = tracker.state();
-    const bool stuck = tracker.failedUpdates() >= 40 && since_global >= 40;
-    if (state == core::TrackState::Empty || state == core::TrackState::Lost || stuck || tracker.awaitingConfirmation())
+    if (tracker.wantsGlobalSearch(true, since_global, 40))  // ~global_interval 40
     {
       found = global.localize(batch.readings);
       searched = batch.reference;

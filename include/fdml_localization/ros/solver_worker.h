@@ -92,8 +92,6 @@ private:
   std::string lostTrackEvent(core::TrackState track, bool* kidnap);
   /// ~result, ~candidates, markers; ~pose, map -> odom and the hand-over while clearly supported.
   void publishTracking(const Job& job, const core::Result& result, const Outcome& outcome);
-  /// True when this batch needs a global search (docs/localizer_node.md#tracking).
-  bool needsGlobalSearch(bool relocalizing) const;
   /// Starts a global search on @p job's readings beside the tracking (global_search_).
   void startGlobalSearch(const Job& job);
   /// Seeds the tracker with the candidates of a finished global search, its new places carried

@@ -142,6 +142,13 @@ Eigen::Matrix3d HypothesisTracker::initialCovariance(const Candidate& candidate)
   return polished.allFinite() && polished.diagonal().minCoeff() > 0.0 ? Eigen::Matrix3d(polished + least) : least;
 }
 
+bool HypothesisTracker::wantsGlobalSearch(bool searching, int since_search, int interval) const
+{
+  const TrackState now = state();
+  const bool stuck = failed_updates_ >= interval && since_search >= interval;
+  return awaitingConfirmation() || (searching && (now == TrackState::Empty || now == TrackState::Lost || stuck));
+}
+
 HintOutcome HypothesisTracker::seedFromHint(const PoseBox& box, const std::vector<Reading>& readings,
                                             const Pose2& reference)
 {

@@ -60,7 +60,7 @@ struct OfficeRun
 
 /// Drives officeMoving(@p seed) for @p duration [s] with k = 10, stride 2, kidnapped at 60 s to
 /// (10, 5.7, 3.0) as the launch does, running a global search
-/// (adaptive, 120 cells) whenever the node would (SolverWorker::needsGlobalSearch), its
+/// (adaptive, 120 cells) whenever the node would (HypothesisTracker::wantsGlobalSearch), its
 /// candidates seeded 1 s of batches later as from the node's worker.
 OfficeRun driveOffice(std::uint64_t seed, double duration)
 {
@@ -95,9 +95,7 @@ OfficeRun driveOffice(std::uint64_t seed, double duration)
     }
     else if (due < 0.0)
     {
-      const core::TrackState state = tracker.state();
-      if (state == core::TrackState::Empty || state == core::TrackState::Lost ||
-          (tracker.failedUpdates() >= 40 && since_global >= 40) || tracker.awaitingConfirmation())
+      if (tracker.wantsGlobalSearch(true, since_global, 40))  // continuous mode, ~global_interval 40
       {
         pending = global.localize(batch.readings);
         searched = batch.reference;

@@ -248,6 +248,15 @@ public:
   /// True when the best hypothesis would be clearly supported but for its confirmations: the
   /// caller should run a global search and seed() its candidates.
   bool awaitingConfirmation() const;
+  /**
+   * @brief Whether the caller should start a global search now (the node's rule): while
+   *        @p searching (relocalizing, or always in continuous mode) when the tracker is empty or
+   *        lost, or when no hypothesis found a fix for @p interval updates and @p since_search
+   *        updates came since the last search (hypotheses that keep finding fixes are only
+   *        ambiguous: another search adds aliases, not evidence); in any mode while a place
+   *        awaits confirmation.
+   */
+  bool wantsGlobalSearch(bool searching, int since_search, int interval) const;
   TrackState state() const;
   /// Updates in a row in which no hypothesis had a fix (0 after a fix).
   int failedUpdates() const

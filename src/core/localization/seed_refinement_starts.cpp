@@ -1,5 +1,6 @@
 // refineSeed()'s later steps (seed_refiner.h): leave-one-out escapes from false minima, the
-// fine polish across a grazing reading's jump, and the multi-start over the region.
+// fine polish across a grazing reading's jump, the multi-start over the region, and the final
+// polish of the best candidates (polishTiedCandidate()).
 #include "fdml_localization/core/localization/seed_refiner.h"
 
 #include <algorithm>
@@ -14,6 +15,9 @@ namespace
 {
 /// Cauchy scale [m] of Refiner::fineFrom()'s polish: about a good range sensor's noise.
 constexpr double kFineScale = 0.002;
+/// At most this many polishes enumerate an ambiguous region (Refiner::enumerate()): about
+/// 25 ms with a few finite readings.
+constexpr std::size_t kRegionPolishes = 512;
 
 /// The reading of @p among with the largest finite residual at @p e (the first of equals); -1
 /// when there is none.
@@ -146,11 +150,7 @@ void Refiner::multiStart()
   {
     return;
   }
-  std::vector<bool> use = finiteInliers(-1);
-  for (std::size_t i = 0; i < readings_.size(); ++i)
-  {
-    use[i] = use[i] || (hypothesis_[i] && std::isfinite(readings_[i].range));
-  }
+  const std::vector<bool> use = hypothesisAndInliers();
   if (countUsed(use) < 3)
   {
     return;
@@ -184,6 +184,44 @@ void Refiner::multiStart()
   polishRounds();
 }
 
+std::vector<bool> Refiner::hypothesisAndInliers() const
+{
+  std::vector<bool> use = finiteInliers(-1);
+  for (std::size_t i = 0; i < readings_.size(); ++i)
+  {
+    use[i] = use[i] || (hypothesis_[i] && std::isfinite(readings_[i].range));
+  }
+  return use;
+}
+
+void Refiner::enumerate(const std::vector<Pose2>& poses, double gate, double reach)
+{
+  const std::vector<bool> use = hypothesisAndInliers();
+  if (countUsed(use) < 3)
+  {
+    return;
+  }
+  std::vector<Pose2> agreeing;
+  for (const Pose2& pose : poses)
+  {
+    const Pose2 start = freeStart(map_, pose, reach);
+    if (std::all_of(readings_.begin(), readings_.end(), [&](const Reading& reading) {
+          return std::abs(readingResidual(map_, start, reading, gate)) < gate;  // false for NaN
+        }))
+    {
+      agreeing.push_back(start);
+    }
+  }
+  const std::size_t n = agreeing.size();
+  const std::size_t polishes = std::min(n, kRegionPolishes);
+  collecting_ = true;
+  for (std::size_t j = 0; j < polishes; ++j)
+  {
+    consider(polish(agreeing[j * n / polishes], use, settings_.agreement_tolerance));
+  }
+  collecting_ = false;
+}
+
 std::vector<Candidate> Refiner::ties() const
 {
   std::vector<Candidate> tied;
@@ -191,6 +229,61 @@ std::vector<Candidate> Refiner::ties() const
   std::copy_if(reached_.begin(), reached_.end(), std::back_inserter(tied),
                [&](const Candidate& c) { return netConsensus(c) >= net; });
   return tied;
+}
+
+namespace
+{
+/// True when one of @p ties lies beyond the uniqueness margins of @p best.
+bool anotherOptimum(const Candidate& best, const std::vector<Candidate>& ties, const LocalizerOptions& options)
+{
+  return std::any_of(ties.begin(), ties.end(), [&](const Candidate& tie) {
+    return (tie.pose.position() - best.pose.position()).norm() > options.uniqueness_distance ||
+           std::abs(angleDiff(tie.pose.theta, best.pose.theta)) > options.uniqueness_angle;
+  });
+}
+}  // namespace
+
+std::vector<Candidate> polishTiedCandidate(const MapRayCaster& map, const std::vector<Reading>& readings,
+                                           const SearchSeed& seed, const RefinementSettings& settings,
+                                           const LocalizerOptions& options, double gate, bool enumerate,
+                                           Candidate& candidate)
+{
+  std::vector<Candidate> ties;
+  Candidate polished = refineSeed(map, candidate.pose, readings, seed.hypothesis, settings,
+                                  seed.region_starts.empty() ? seed.retry_starts : seed.region_starts, &ties);
+  if (enumerate && seed.region_poses && anotherOptimum(polished, ties, options))
+  {
+    const std::vector<Pose2> none;
+    Refiner refiner(map, polished.pose, readings, seed.hypothesis, settings, none);
+    refiner.enumerate(*seed.region_poses, gate, 0.5 * settings.multi_start_step);
+    const std::vector<Candidate> more = refiner.ties();
+    std::copy(more.begin(), more.end(), std::back_inserter(ties));
+    Candidate best = refiner.candidate();
+    if (betterCandidate(best, polished))
+    {
+      polished = std::move(best);
+    }
+  }
+  if (betterCandidate(polished, candidate))
+  {
+    polished.support = candidate.support;
+    candidate = std::move(polished);
+  }
+  settleAlongContinua(map, readings, settings, candidate);
+  // A tie within the uniqueness margins of the candidate is its duplicate, but first widens its
+  // covariance to cover it (absorbTiedDuplicates()): de-duplicated among themselves first, the
+  // ties could lose the one that is the truth.
+  std::vector<Candidate> own{ candidate };
+  absorbTiedDuplicates(ties, options.uniqueness_distance, options.uniqueness_angle, settings.noise_sigma, own);
+  candidate.covariance = own.front().covariance;
+  ties = rankAndDeduplicate(std::move(ties), options.uniqueness_distance, options.uniqueness_angle,
+                            options.max_candidates);
+  for (Candidate& tie : ties)
+  {
+    tie.support = candidate.support;
+    settleAlongContinua(map, readings, settings, tie);
+  }
+  return ties;
 }
 
 }  // namespace core

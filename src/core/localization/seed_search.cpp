@@ -1,6 +1,7 @@
 #include "fdml_localization/core/localization/seed_search.h"
 
 #include "fdml_localization/core/localization/ranking.h"
+#include "fdml_localization/core/localization/seed_refiner.h"
 #include "fdml_localization/core/util/stopwatch.h"
 
 #include <omp.h>
@@ -208,13 +209,25 @@ public:
 
 private:
   /// The candidates tied at the best net consensus get the multi-start, which adds the other optima
-  /// of their regions tying them; every candidate gets its covariance widened along continua.
+  /// of their regions tying them (polishTiedCandidate(); the first of each region enumerates it
+  /// when it holds several); every candidate gets its covariance widened along continua.
   void polishTop(int level, const LocalizerOptions& options, std::vector<Candidate>& kept) const
   {
     RefinementSettings with = levelSettings(level);
     with.multi_start = 1;
     with.collect_ties = true;
     const int top = kept.empty() ? 0 : netConsensus(kept.front());
+    std::vector<char> first_of_region(kept.size(), 0);
+    std::vector<std::size_t> regions;
+    for (std::size_t j = 0; j < kept.size(); ++j)
+    {
+      const std::size_t region = seeds_[static_cast<std::size_t>(kept[j].support)].region;
+      if (netConsensus(kept[j]) >= top && std::find(regions.begin(), regions.end(), region) == regions.end())
+      {
+        regions.push_back(region);
+        first_of_region[j] = 1;
+      }
+    }
     std::vector<std::vector<Candidate>> ties(kept.size());
 #pragma omp parallel for schedule(dynamic, 1) num_threads(ctx_.threads) if (kept.size() >= 2)
     for (std::size_t j = 0; j < kept.size(); ++j)
@@ -226,29 +239,8 @@ private:
         settleAlongContinua(ctx_.map, ctx_.readings, ctx_.settings, kept[j]);
         continue;
       }
-      const SearchSeed& seed = seeds_[static_cast<std::size_t>(kept[j].support)];
-      Candidate polished = refineSeed(ctx_.map, kept[j].pose, ctx_.readings, seed.hypothesis, with,
-                                      seed.region_starts.empty() ? seed.retry_starts : seed.region_starts, &ties[j]);
-      if (betterCandidate(polished, kept[j]))
-      {
-        polished.support = kept[j].support;
-        kept[j] = std::move(polished);
-      }
-      settleAlongContinua(ctx_.map, ctx_.readings, ctx_.settings, kept[j]);
-      // A tie within the uniqueness margins of kept[j] is its duplicate, but first widens its
-      // covariance to cover it (absorbTiedDuplicates()): de-duplicated among themselves first,
-      // the ties could lose the one that is the truth.
-      std::vector<Candidate> own{ kept[j] };
-      absorbTiedDuplicates(ties[j], options.uniqueness_distance, options.uniqueness_angle, ctx_.settings.noise_sigma,
-                           own);
-      kept[j].covariance = own.front().covariance;
-      ties[j] = rankAndDeduplicate(std::move(ties[j]), options.uniqueness_distance, options.uniqueness_angle,
-                                   options.max_candidates);
-      for (Candidate& tie : ties[j])
-      {
-        tie.support = kept[j].support;
-        settleAlongContinua(ctx_.map, ctx_.readings, ctx_.settings, tie);
-      }
+      ties[j] = polishTiedCandidate(ctx_.map, ctx_.readings, seeds_[static_cast<std::size_t>(kept[j].support)], with,
+                                    options, ctx_.loose_gate, first_of_region[j] != 0, kept[j]);
     }
     for (std::vector<Candidate>& found : ties)
     {

@@ -226,6 +226,15 @@ const PastMiss kPastMisses[] = {
   { "ParallelRaysAreLeftOutTogether", 2, 2, 842,
     "driving map 2 k 5 exact truth (10.109787098840641, 8.0528263757839955, "
     "-1.4874963550146991)" },
+  // Twenty-sixth round (`--seed 856 --k 4:6 --random-maps 2 --buildings 2`, map 1, a random
+  // 70-gon): turning in place, three finite readings and three no-returns. One region of 5,521
+  // voxels explains all six and holds twelve exact poses (seven places beyond the uniqueness
+  // margins); its twelve spread starts reached four, and five inexact places filled the list:
+  // the voxel engine missed the truth. A region whose multi-start reaches a second optimum now
+  // polishes from each of its poses where every reading agrees (Refiner::enumerate()).
+  { "ARegionHoldingSeveralOptimaIsEnumerated", 2, 2, 856,
+    "no-return map 1 k 6 exact truth (-0.042224358944845441, 0.49065879947526447, 1.428060631727158) "
+    "max range 1.5338566607329369" },
 };
 
 INSTANTIATE_TEST_SUITE_P(Lessons, PastMissesOnGeneratedMaps, ::testing::ValuesIn(kPastMisses),

@@ -2,12 +2,13 @@
  * @file seed_refiner.h
  * @brief The steps of refineSeed() (robust_search.h): the state of one refinement. Internal to
  *        the robust search; declared here so that its steps can live in two sources
- *        (seed_refinement.cpp: polishes and rounds; seed_refinement_starts.cpp: escapes and the
- *        multi-start).
+ *        (seed_refinement.cpp: polishes and rounds; seed_refinement_starts.cpp: escapes, the
+ *        multi-start and the final polish of the best candidates).
  */
 #pragma once
 
 #include "fdml_localization/core/localization/robust_search.h"
+#include "fdml_localization/core/localization/seed_search.h"
 
 #include <algorithm>
 #include <vector>
@@ -48,6 +49,10 @@ public:
   void polishRounds();
   void escapes();
   void multiStart();
+  /// Polishes from each of @p poses (at most kRegionPolishes of them, spread over the list)
+  /// where every reading agrees within @p gate [m], moved off walls within @p reach [m] first,
+  /// collecting what they reach for ties().
+  void enumerate(const std::vector<Pose2>& poses, double gate, double reach);
   Candidate candidate() const;
   std::vector<Candidate> ties() const;  ///< the optima multiStart() reached tying the best
 
@@ -66,6 +71,8 @@ private:
   /// readings almost as well). Polish at a fine Cauchy scale, which discounts the jump, then
   /// again without the reading left worst; keep whatever improves.
   void fineFrom(const Pose2& start, const std::vector<bool>& use);
+  /// The multi-start's readings: the hypothesis's finite readings and the best pose's inliers.
+  std::vector<bool> hypothesisAndInliers() const;
   /// The finite-range inliers of the best pose, without reading @p drop (-1: none).
   std::vector<bool> finiteInliers(int drop) const;
   /// finiteInliers() without reading @p drop nor the others pointing its way (parallelRays()).
@@ -85,6 +92,22 @@ private:
   bool collecting_ = false;
   std::vector<Candidate> reached_;  ///< every polish result of multiStart() (collect_ties)
 };
+
+/**
+ * @brief The final polish of a candidate tied at the best net consensus (robustSearch()):
+ *        refineSeed() with settings.collect_ties from @p candidate's pose and its seed's region
+ *        starts. When @p enumerate and that multi-start reached another optimum tying it beyond
+ *        the uniqueness margins, the region holds several optima (readings that leave the place
+ *        ambiguous) and a dozen spread starts can miss some: then every pose of
+ *        seed.region_poses where all readings agree within @p gate [m] is polished from too
+ *        (Refiner::enumerate()). @p candidate is improved in place (its support kept), its
+ *        covariance widened over the ties within the margins, both settled along continua.
+ * @return the distinct other optima tying it, ranked, at most options.max_candidates
+ */
+std::vector<Candidate> polishTiedCandidate(const MapRayCaster& map, const std::vector<Reading>& readings,
+                                           const SearchSeed& seed, const RefinementSettings& settings,
+                                           const LocalizerOptions& options, double gate, bool enumerate,
+                                           Candidate& candidate);
 
 }  // namespace core
 }  // namespace fdml_localization

@@ -13,6 +13,7 @@
 #include "fdml_localization/core/localization/robust_search.h"
 
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 namespace fdml_localization
@@ -29,6 +30,10 @@ struct SearchSeed
   /// Poses spread over the region, for the final multi-start of the candidate the seed gives
   /// (empty: retry_starts)
   std::vector<Pose2> region_starts;
+  /// Every pose of a region larger than region_starts (voxel or leaf centres), shared by its
+  /// seeds: where the final multi-start finds several optima tying at the best consensus, each
+  /// agreeing one is polished (polishTiedCandidate()). Null: region_starts are all its poses.
+  std::shared_ptr<const std::vector<Pose2>> region_poses;
   std::size_t region = 0;  ///< the engine's id of the seed's region (voxel, leaf cluster)
   double support = 0.0;    ///< size of the seed's region (voxels or boxes)
 };

@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 
 namespace fdml_localization
 {
@@ -130,6 +131,15 @@ public:
         for (std::size_t j = 0; j < spread; ++j)
         {
           seed.region_starts.push_back(leafStart(cluster.members[j * n / spread]));
+        }
+        if (n > spread)
+        {
+          auto all = std::make_shared<std::vector<Pose2>>();
+          for (std::size_t m : cluster.members)
+          {
+            all->push_back(found.leaves[m].box.centre());
+          }
+          seed.region_poses = std::move(all);
         }
         seeds.push_back(std::move(seed));
       }

@@ -18,6 +18,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iterator>
+#include <memory>
 #include <numeric>
 
 namespace fdml_localization
@@ -128,6 +130,14 @@ private:
     for (std::size_t j = 0; j < spread; ++j)
     {
       seed.region_starts.push_back(freeStart(map_, spec.centre(plateau.voxels[j * n / spread]), spec.cell));
+    }
+    if (n > spread)
+    {
+      auto all = std::make_shared<std::vector<Pose2>>();
+      all->reserve(n);
+      std::transform(plateau.voxels.begin(), plateau.voxels.end(), std::back_inserter(*all),
+                     [&](std::size_t v) { return spec.centre(v); });
+      seed.region_poses = std::move(all);
     }
     return seed;
   }

@@ -235,6 +235,12 @@ const PastMiss kPastMisses[] = {
   { "ARegionHoldingSeveralOptimaIsEnumerated", 2, 2, 856,
     "no-return map 1 k 6 exact truth (-0.042224358944845441, 0.49065879947526447, 1.428060631727158) "
     "max range 1.5338566607329369" },
+  // The same round's next hunt (`--seed 857 --k 4:6`, map 1): turning in place, three finite
+  // readings and a no-return; one plateau of the adaptive engine (300 leaves) holds four exact
+  // places, and its spread starts missed the truth's. Enumerating the plateau finds it.
+  { "ALeafPlateauHoldingSeveralOptimaIsEnumerated", 2, 2, 857,
+    "no-return map 1 k 4 exact truth (0.39055637038814028, -0.58622987012268268, -0.30098950449821693) "
+    "max range 2.0006669509333532" },
 };
 
 INSTANTIATE_TEST_SUITE_P(Lessons, PastMissesOnGeneratedMaps, ::testing::ValuesIn(kPastMisses),

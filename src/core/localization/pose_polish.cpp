@@ -329,33 +329,47 @@ Eigen::Matrix3d oneDirectionLostCovariance(const MapRayCaster& map, const Pose2&
     }
   }
   const Eigen::Matrix3d with_all = poseCovariance(map, all, noise_sigma);
+  const auto excessOf = [&](const Eigen::Matrix3d& without) {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> excess(0.5 * without - with_all);
+    const Eigen::Vector3d kept = excess.eigenvalues().cwiseMax(0.0);
+    return Eigen::Matrix3d(excess.eigenvectors() * kept.asDiagonal() * excess.eigenvectors().transpose());
+  };
+  // The group (around each used reading) whose loss leaves the largest covariance
+  // (determinant); and, over groups that do not overlap, the excess of every other group some of
+  // whose finite readings disagree (spoilt: shortened by a person who may also be read as a
+  // wall at a slant by the rest).
   Eigen::Matrix3d worst = with_all;
+  Eigen::Matrix3d spoilt_excess = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d worst_spoilt = Eigen::Matrix3d::Zero();
+  std::vector<char> covered(readings.size(), 0);
   for (std::size_t i = 0; i < readings.size(); ++i)
   {
     if (!used[i])
     {
       continue;
     }
+    const bool first = !covered[i];
     System rest = all;  // the noise estimated from every reading
+    bool spoilt = false;
     for (std::size_t j = 0; j < readings.size(); ++j)
     {
       if (std::abs(angleDiff(readings[j].offset.theta, readings[i].offset.theta)) <= group_angle)
       {
         rest.jtj -= jtj[j];
+        covered[j] = covered[j] || first;
+        spoilt = spoilt || (!use[j] && std::isfinite(readings[j].range));
       }
     }
     const Eigen::Matrix3d without = poseCovariance(map, rest, noise_sigma);
+    const Eigen::Matrix3d excess = first && spoilt ? excessOf(without) : Eigen::Matrix3d::Zero();
+    spoilt_excess += excess;
     if (without.determinant() > worst.determinant())
     {
       worst = without;
+      worst_spoilt = excess;
     }
   }
-  // Two directions fixing the pose equally: without either, twice the covariance; half of it
-  // is what they give together, so nothing is added. Only what exceeds that (a direction one
-  // group fixes alone, or nearly) is: the positive part of worst / 2 - with_all.
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> excess(0.5 * worst - with_all);
-  const Eigen::Vector3d kept = excess.eigenvalues().cwiseMax(0.0);
-  return excess.eigenvectors() * kept.asDiagonal() * excess.eigenvectors().transpose();
+  return excessOf(worst) + spoilt_excess - worst_spoilt;
 }
 
 }  // namespace core

@@ -288,51 +288,6 @@ TEST(LocalizerInput, ParseAndPrintNames)
   EXPECT_THROW(parseEngine(""), std::invalid_argument);
 }
 
-/// Four sensors (front, left, back, right) 0.15 m from the centre, twice each.
-std::vector<Pose2> fourSensorsTwice()
-{
-  std::vector<Pose2> offsets;
-  for (int i = 0; i < 8; ++i)
-  {
-    const double a = (i % 4) * 0.5 * kPi;
-    offsets.emplace_back(0.15 * std::cos(a), 0.15 * std::sin(a), wrapAngle(a));
-  }
-  return offsets;
-}
-
-TEST(OneDirectionLost, AddsOnlyWhereOneSensorAloneFixesTheDirection)
-{
-  const auto room_and_corridor = [](double length) {
-    return std::make_shared<const MapRayCaster>(
-        PolygonMap::fromRings({ { { 0, 0 }, { length, 0 }, { length, 2 }, { 0, 2 } } }));
-  };
-  const std::vector<bool> all(8, true);
-  // A 5 m x 2 m room, the robot turned 0.3 rad: each of x, y fixed by two opposite sensors.
-  const auto room = room_and_corridor(5.0);
-  const Pose2 in_room(2.4, 1.1, 0.3);
-  const std::vector<Reading> room_readings = test::exactReadings(*room, in_room, fourSensorsTwice());
-  const Eigen::Matrix3d base = polishPose(*room, in_room, room_readings, all, 0.0, 0, 0.01).covariance;
-  const Eigen::Matrix3d added = oneDirectionLostCovariance(*room, in_room, room_readings, all, 0.01, 0.25);
-  // Small: a few mm (x and the heading need front and back together at this angle).
-  EXPECT_LT(added.trace(), 1e-3) << added << "\nbase\n" << base;
-  // A 20 m corridor, the back sensor seeing nothing within 8 m: only the front one fixes x.
-  const auto corridor = room_and_corridor(20.0);
-  const Pose2 in_corridor(15.0, 1.0, 0.0);
-  std::vector<Reading> readings = test::exactReadings(*corridor, in_corridor, fourSensorsTwice());
-  for (Reading& r : readings)
-  {
-    r.max_range = 8.0;
-    r.range = r.range > 8.0 ? kInf : r.range;
-  }
-  const Eigen::Matrix3d lost = oneDirectionLostCovariance(*corridor, in_corridor, readings, all, 0.01, 0.25);
-  EXPECT_GT(lost(0, 0), 1.0) << lost;   // x: no better than the prior (the map's size) without it
-  EXPECT_LT(lost(1, 1), 1e-6) << lost;  // y: fixed by left and right alike
-  // A group angle of 0 still groups a sensor's two readings (one mounting heading).
-  EXPECT_GT(oneDirectionLostCovariance(*corridor, in_corridor, readings, all, 0.01, 0.0)(0, 0), 1.0);
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(lost);
-  EXPECT_GE(eigen.eigenvalues().minCoeff(), -1e-12);  // positive semi-definite
-}
-
 TEST(CandidateRefinement, PolishConvergesAndRankingDropsDuplicates)
 {
   const auto map = test::lRoomMap();

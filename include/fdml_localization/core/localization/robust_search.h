@@ -133,7 +133,10 @@ void ensureCovariance(const MapRayCaster& map, const std::vector<Reading>& readi
  *        whose loss leaves the largest (determinant) and C that of every reading, returns the
  *        positive part of W / 2 - C: zero where every direction is fixed by two groups alike
  *        (without either the covariance doubles), about W where one group fixes a direction
- *        alone. Positive semi-definite.
+ *        alone. Plus the same part of every other group with a finite reading @p use leaves out
+ *        (a disagreeing reading: a person in front of that sensor, whom its other readings may
+ *        explain as a wall at a slant), so that such a group fixes no direction alone even when
+ *        losing another group leaves the larger covariance. Positive semi-definite.
  * @param noise_sigma lower bound on the residual standard deviation [m], as in polishPose()
  */
 Eigen::Matrix3d oneDirectionLostCovariance(const MapRayCaster& map, const Pose2& pose,

@@ -240,6 +240,42 @@ Eigen::Matrix3d poseCovariance(const MapRayCaster& map, const System& sys, doubl
   covariance = 0.5 * (covariance + covariance.transpose());
   return covariance.allFinite() ? covariance : Eigen::Matrix3d::Identity() * 1e6;
 }
+/// Each used finite reading's own J^T J in @p jtj (one cast each; @p used marks them) and their
+/// sum: the accounting of buildSystem() without the robust loss.
+System informationPerReading(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings,
+                             const std::vector<bool>& use, std::vector<Eigen::Matrix3d>& jtj, std::vector<char>& used)
+{
+  System all;
+  const Rotation rq(pose.theta);
+  for (std::size_t i = 0; i < readings.size(); ++i)
+  {
+    if (!use[i] || !std::isfinite(readings[i].range))
+    {
+      continue;
+    }
+    Vec2 hint = Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
+    const ResidualRow row = readingRow(map, pose, rq, readings[i], Rotation(readings[i].offset.theta), hint);
+    used[i] = 1;
+    ++all.used;
+    if (row.valid)
+    {
+      jtj[i] = row.jacobian.transpose() * row.jacobian;
+      all.jtj += jtj[i];
+      all.sum_sq += row.r * row.r;
+    }
+  }
+  return all;
+}
+
+/// The positive part of @p without / 2 - @p with_all: two groups fixing a direction equally
+/// (without either, twice the covariance; half of it is what they give together) add nothing.
+Eigen::Matrix3d excessOver(const Eigen::Matrix3d& without, const Eigen::Matrix3d& with_all)
+{
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> excess(0.5 * without - with_all);
+  const Eigen::Vector3d kept = excess.eigenvalues().cwiseMax(0.0);
+  return excess.eigenvectors() * kept.asDiagonal() * excess.eigenvectors().transpose();
+}
+
 }  // namespace
 
 PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std::vector<Reading>& readings,
@@ -305,35 +341,10 @@ Eigen::Matrix3d oneDirectionLostCovariance(const MapRayCaster& map, const Pose2&
                                            const std::vector<Reading>& readings, const std::vector<bool>& use,
                                            double noise_sigma, double group_angle)
 {
-  // Each used reading's own J^T J (one cast each), then sums over subsets; the accounting of
-  // buildSystem() without the robust loss.
   std::vector<Eigen::Matrix3d> jtj(readings.size(), Eigen::Matrix3d::Zero());
   std::vector<char> used(readings.size(), 0);
-  System all;
-  const Rotation rq(pose.theta);
-  for (std::size_t i = 0; i < readings.size(); ++i)
-  {
-    if (!use[i] || !std::isfinite(readings[i].range))
-    {
-      continue;
-    }
-    Vec2 hint = Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
-    const ResidualRow row = readingRow(map, pose, rq, readings[i], Rotation(readings[i].offset.theta), hint);
-    used[i] = 1;
-    ++all.used;
-    if (row.valid)
-    {
-      jtj[i] = row.jacobian.transpose() * row.jacobian;
-      all.jtj += jtj[i];
-      all.sum_sq += row.r * row.r;
-    }
-  }
+  const System all = informationPerReading(map, pose, readings, use, jtj, used);
   const Eigen::Matrix3d with_all = poseCovariance(map, all, noise_sigma);
-  const auto excessOf = [&](const Eigen::Matrix3d& without) {
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> excess(0.5 * without - with_all);
-    const Eigen::Vector3d kept = excess.eigenvalues().cwiseMax(0.0);
-    return Eigen::Matrix3d(excess.eigenvectors() * kept.asDiagonal() * excess.eigenvectors().transpose());
-  };
   // The group (around each used reading) whose loss leaves the largest covariance
   // (determinant); and, over groups that do not overlap, the excess of every other group some of
   // whose finite readings disagree (spoilt: shortened by a person who may also be read as a
@@ -361,7 +372,7 @@ Eigen::Matrix3d oneDirectionLostCovariance(const MapRayCaster& map, const Pose2&
       }
     }
     const Eigen::Matrix3d without = poseCovariance(map, rest, noise_sigma);
-    const Eigen::Matrix3d excess = first && spoilt ? excessOf(without) : Eigen::Matrix3d::Zero();
+    const Eigen::Matrix3d excess = first && spoilt ? excessOver(without, with_all) : Eigen::Matrix3d::Zero();
     spoilt_excess += excess;
     if (without.determinant() > worst.determinant())
     {
@@ -369,7 +380,7 @@ Eigen::Matrix3d oneDirectionLostCovariance(const MapRayCaster& map, const Pose2&
       worst_spoilt = excess;
     }
   }
-  return excessOf(worst) + spoilt_excess - worst_spoilt;
+  return excessOver(worst, with_all) + spoilt_excess - worst_spoilt;
 }
 
 }  // namespace core

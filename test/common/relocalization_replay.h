@@ -47,12 +47,16 @@ struct ReplayAnswers
   int right = 0, wrong = 0, unanswered = 0;
   double seconds = 0.0;  ///< summed time from the kidnap to the answer [s]
   std::string first_wrong;
+  /// With a follow time: the updates after the answers that published a pose, and the wrong ones.
+  int followed_published = 0, followed_wrong = 0;
 };
 
 /// One relocalization after a kidnap at simulated time @p kidnapped [s]: searches and updates on
-/// the batches of readings all taken after it, for at most @p timeout [s].
+/// the batches of readings all taken after it, for at most @p timeout [s]; then, for @p follow [s]
+/// after the answer, the same updates go on (tracking, as the node does) and what they publish is
+/// scored.
 inline void relocalize(Drive& drive, double kidnapped, double timeout, core::HypothesisTracker& tracker,
-                       core::Localizer& global, ReplayAnswers* answers)
+                       core::Localizer& global, ReplayAnswers* answers, double follow = 0.0)
 {
   tracker.clear();
   core::Result found;
@@ -60,7 +64,8 @@ inline void relocalize(Drive& drive, double kidnapped, double timeout, core::Hyp
   bool pending = false;
   int since_global = 0;
   DriveBatch batch;
-  while (drive.next(&batch, kidnapped + timeout))
+  double answered = -1.0;  // simulated time of the answer [s]
+  while (drive.next(&batch, answered < 0.0 ? kidnapped + timeout : answered + follow))
   {
     if (batch.start_time <= kidnapped)
     {
@@ -80,6 +85,11 @@ inline void relocalize(Drive& drive, double kidnapped, double timeout, core::Hyp
     }
     since_global += tracker.hypotheses().empty() ? 0 : 1;
     tracker.update(batch.readings, batch.reference);
+    if (answered >= 0.0)
+    {
+      scorePublished(tracker, batch, &answers->followed_published, &answers->followed_wrong);
+      continue;
+    }
     int published = 0;
     const std::string error = scorePublished(tracker, batch, &published, &answers->wrong);
     answers->first_wrong = answers->first_wrong.empty() ? error : answers->first_wrong;
@@ -87,18 +97,23 @@ inline void relocalize(Drive& drive, double kidnapped, double timeout, core::Hyp
     {
       answers->right += error.empty() ? 1 : 0;
       answers->seconds += batch.time - kidnapped;
-      return;
+      answered = batch.time;
+      if (follow <= 0.0)
+      {
+        return;
+      }
     }
   }
-  ++answers->unanswered;
+  answers->unanswered += answered < 0.0 ? 1 : 0;
 }
 
-/// @p kidnaps relocalizations (each allowed @p timeout [s]) in @p scenario on @p map, batches of
-/// @p k readings sliding by @p stride (formed per reading, as the node forms them), @p tracker
-/// and @p search the node's tracker and tracking global search.
+/// @p kidnaps relocalizations (each allowed @p timeout [s], then followed for @p follow [s]) in
+/// @p scenario on @p map, batches of @p k readings sliding by @p stride (formed per reading, as
+/// the node forms them), @p tracker and @p search the node's tracker and tracking global search.
 inline ReplayAnswers replayKidnaps(const core::ScenarioConfig& scenario, std::shared_ptr<const core::MapRayCaster> map,
                                    int k, int stride, const core::TrackerOptions& tracker_options,
-                                   const core::LocalizerOptions& search, int kidnaps, double timeout)
+                                   const core::LocalizerOptions& search, int kidnaps, double timeout,
+                                   double follow = 0.0)
 {
   Drive drive(simulate(scenario, map), k, stride, true);
   core::HypothesisTracker tracker(map, tracker_options);
@@ -112,7 +127,7 @@ inline ReplayAnswers replayKidnaps(const core::ScenarioConfig& scenario, std::sh
     {
       throw std::runtime_error("kidnap: " + message);
     }
-    relocalize(drive, drive.sim().time(), timeout, tracker, global, &answers);
+    relocalize(drive, drive.sim().time(), timeout, tracker, global, &answers, follow);
   }
   return answers;
 }

@@ -1,15 +1,18 @@
 // Relocalizations replayed ROS-free (relocalization_replay.h): the fraction of kidnaps the
 // node's relocalization answers right, wrong or not at all, and the time to the answer, over
-// many scenario seeds. Prints a line per seed and a summary; exits 1 when any answer was wrong,
+// many scenario seeds. Prints a line per seed and a summary; exits 1 when any answer (or, with
+// --follow, any update after one) was wrong,
 // 2 on a bad flag.
 //   replay_relocalizations [--scenario demo|patrol] [--seeds FIRST:LAST] [--kidnaps N]
-//                          [--confirm N] [--min-support S] [--timeout SECONDS]
+//                          [--confirm N] [--min-support S] [--timeout SECONDS] [--follow SECONDS]
 // demo: config/scenarios/demo.yaml (turning in place, four cones at 1.6 Hz, three people, two
 // chairs; k = 10, stride 1, as make demo runs it). patrol: config/scenarios/apartment_patrol.yaml
 // (driving, four rays at 10 Hz, five people; k = 10, stride 2 and the odometry noise of
 // tracking_patrol.test). Both on maps/apartment.poly, the tracker at config/localizer.yaml's
 // settings with range_tolerance 0.03 m (the launches'); --confirm and --min-support override
-// confirm_searches and min_support.
+// confirm_searches and min_support. --follow S keeps tracking S seconds after each answer and
+// counts the updates that publish a pose and the wrong ones among them (a wrong answer that
+// persists).
 #include "localizer_test_utils.h"
 #include "relocalization_replay.h"
 
@@ -30,6 +33,7 @@ struct Args
   bool patrol = false;
   int first_seed = 1, last_seed = 10, kidnaps = 100;
   double timeout = 30.0;
+  double follow = 0.0;
   core::TrackerOptions tracker;
 };
 
@@ -74,11 +78,19 @@ void apply(const std::string& flag, const std::string& value, Args& args)
       throw std::invalid_argument("--timeout needs (0, 3600] s, got '" + value + "'");
     }
   }
+  else if (flag == "--follow")
+  {
+    args.follow = core::parseNumber(value, "--follow");
+    if (!(args.follow >= 0.0 && args.follow <= 600.0))
+    {
+      throw std::invalid_argument("--follow needs [0, 600] s, got '" + value + "'");
+    }
+  }
   else
   {
     throw std::invalid_argument("unknown flag or value: " + flag + " " + value +
                                 " (flags: --scenario demo|patrol, --seeds FIRST:LAST, --kidnaps N, --confirm N, "
-                                "--min-support S, --timeout SECONDS)");
+                                "--min-support S, --timeout SECONDS, --follow SECONDS)");
   }
 }
 
@@ -99,7 +111,7 @@ fdml_test::ReplayAnswers replaySeed(const Args& args, const std::shared_ptr<cons
     o.odom_alpha3 = 0.21;
     o.odom_alpha4 = 0.1;
   }
-  return fdml_test::replayKidnaps(scenario, map, 10, stride, o, search, args.kidnaps, args.timeout);
+  return fdml_test::replayKidnaps(scenario, map, 10, stride, o, search, args.kidnaps, args.timeout, args.follow);
 }
 }  // namespace
 
@@ -137,17 +149,29 @@ int main(int argc, char** argv)
       std::cerr << "replay_relocalizations: seed " << seed << ": " << e.what() << "\n";
       return 2;
     }
-    std::printf("seed %d: right %d wrong %d unanswered %d%s%s\n", seed, a.right, a.wrong, a.unanswered,
-                a.first_wrong.empty() ? "" : "; ", a.first_wrong.c_str());
+    std::printf("seed %d: right %d wrong %d unanswered %d", seed, a.right, a.wrong, a.unanswered);
+    if (args.follow > 0.0)
+    {
+      std::printf("; followed: published %d wrong %d", a.followed_published, a.followed_wrong);
+    }
+    std::printf("%s%s\n", a.first_wrong.empty() ? "" : "; ", a.first_wrong.c_str());
     total.right += a.right;
     total.wrong += a.wrong;
     total.unanswered += a.unanswered;
     total.seconds += a.seconds;
+    total.followed_published += a.followed_published;
+    total.followed_wrong += a.followed_wrong;
   }
   const int answered = total.right + total.wrong;
   std::printf("%s, seeds %d to %d, %d kidnaps each: right %d, wrong %d, unanswered %d; mean time to the answer "
               "%.2f s\n",
               args.patrol ? "patrol" : "demo", args.first_seed, args.last_seed, args.kidnaps, total.right, total.wrong,
               total.unanswered, answered > 0 ? total.seconds / answered : 0.0);
-  return total.wrong > 0 ? 1 : 0;
+  if (args.follow > 0.0)
+  {
+    std::printf("followed %.1f s after each answer: %d updates published a pose, %d of them wrong (%.2f %%)\n",
+                args.follow, total.followed_published, total.followed_wrong,
+                total.followed_published > 0 ? 100.0 * total.followed_wrong / total.followed_published : 0.0);
+  }
+  return total.wrong > 0 || total.followed_wrong > 0 ? 1 : 0;
 }

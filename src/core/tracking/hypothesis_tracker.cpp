@@ -18,6 +18,12 @@ namespace core
 {
 namespace
 {
+/// The smallest box of a hypothesis whose last fix only just reached k', in units of
+/// box_min_xy ...
+constexpr double kDoubtfulBoxXy = 2.0;
+/// ... and of box_min_theta (HypothesisTracker::boxOf()).
+constexpr double kDoubtfulBoxTheta = 3.0;
+
 /// @p m reduced to at most @p bound in every direction: its eigenvalues relative to @p bound
 /// (whitened by bound's Cholesky factor) clamped to 1. @p m when @p bound is not positive definite.
 Eigen::Matrix3d cappedBy(const Eigen::Matrix3d& m, const Eigen::Matrix3d& bound)
@@ -114,12 +120,20 @@ PoseBox HypothesisTracker::boxOf(const Hypothesis& h, const Pose2& reference) co
 {
   const Pose2 p = compose(h.map_to_odom, reference);
   const TrackerOptions& o = options_;
+  // A last fix that only just reached k' may be a place alike beside the truth (a heading a few
+  // degrees off explaining people as walls at a slant, precise from them): the box then reaches
+  // at least kDoubtfulBoxXy and kDoubtfulBoxTheta times the smallest, where a fix explaining more
+  // readings shows it.
+  const int k = static_cast<int>(h.last_fix.inlier_mask.size());
+  const bool doubtful = h.fixes > 0 && netConsensus(h.last_fix) <= minConsensus(k);
   const double xy =
-      std::min(o.box_max_xy, std::max(positionSigma3(h.covariance),
-                                      o.box_min_xy + 3.0 * (o.odom_alpha3 * h.travelled + o.odom_alpha4 * h.turned)));
+      std::min(o.box_max_xy, std::max({ positionSigma3(h.covariance),
+                                        o.box_min_xy + 3.0 * (o.odom_alpha3 * h.travelled + o.odom_alpha4 * h.turned),
+                                        doubtful ? kDoubtfulBoxXy * o.box_min_xy : 0.0 }));
   const double theta = std::min(
-      o.box_max_theta, std::max(headingSigma3(h.covariance),
-                                o.box_min_theta + 3.0 * (o.odom_alpha1 * h.turned + o.odom_alpha2 * h.travelled)));
+      o.box_max_theta, std::max({ headingSigma3(h.covariance),
+                                  o.box_min_theta + 3.0 * (o.odom_alpha1 * h.turned + o.odom_alpha2 * h.travelled),
+                                  doubtful ? kDoubtfulBoxTheta * o.box_min_theta : 0.0 }));
   return PoseBox{ p.x - xy, p.x + xy, p.y - xy, p.y + xy, p.theta - theta, p.theta + theta };
 }
 

@@ -98,19 +98,10 @@ void apply(const std::string& flag, const std::string& value, Args& args)
 fdml_test::ReplayAnswers replaySeed(const Args& args, const std::shared_ptr<const core::MapRayCaster>& map, int seed)
 {
   const core::LocalizerOptions search = fdml_test::globalSearchOptions(120, 0.03);
-  core::TrackerOptions o = args.tracker;
-  o.range_tolerance = search.range_tolerance;
-  o.agreement_tolerance = search.agreement_tolerance;
+  const core::TrackerOptions o = fdml_test::replayTrackerOptions(args.tracker, search, args.patrol);
   core::ScenarioConfig scenario = args.patrol ? fdml_test::apartmentPatrol(5) : fdml_test::demoScenario(seed);
   scenario.seed = static_cast<std::uint64_t>(seed);
   const int stride = args.patrol ? 2 : 1;
-  o.fix_covariance_scale = 10.0 / stride;
-  if (args.patrol)
-  {
-    o.odom_alpha2 = 0.05;
-    o.odom_alpha3 = 0.21;
-    o.odom_alpha4 = 0.1;
-  }
   return fdml_test::replayKidnaps(scenario, map, 10, stride, o, search, args.kidnaps, args.timeout, args.follow);
 }
 }  // namespace

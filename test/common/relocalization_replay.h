@@ -41,24 +41,6 @@ inline core::ScenarioConfig demoScenario(std::uint64_t seed)
   return c;
 }
 
-/// The node's tracker for the replays: config/localizer.yaml's settings with @p search's
-/// tolerances (the launches'), fix_covariance_scale k / stride as the node sets it (k = 10), and
-/// for the @p patrol (stride 2) tracking_patrol.test's odometry noise.
-inline core::TrackerOptions replayTrackerOptions(core::TrackerOptions o, const core::LocalizerOptions& search,
-                                                 bool patrol)
-{
-  o.range_tolerance = search.range_tolerance;
-  o.agreement_tolerance = search.agreement_tolerance;
-  o.fix_covariance_scale = patrol ? 5.0 : 10.0;
-  if (patrol)
-  {
-    o.odom_alpha2 = 0.05;
-    o.odom_alpha3 = 0.21;
-    o.odom_alpha4 = 0.1;
-  }
-  return o;
-}
-
 /// What the relocalizations answered.
 struct ReplayAnswers
 {

@@ -236,6 +236,25 @@ inline core::LocalizerOptions globalSearchOptions(int resolution, double tau)
   return g;
 }
 
+/// The node's tracker as the launches run it: @p o (config/localizer.yaml's settings) with
+/// @p search's tolerances, fix_covariance_scale k / ~batch_stride as the node sets it (k = 10),
+/// and @p driving (stride 2: tracking_patrol.test, tracking_office.test) the rostests' odometry
+/// noise; otherwise stride 1 (the demo, turning in place).
+inline core::TrackerOptions launchTrackerOptions(core::TrackerOptions o, const core::LocalizerOptions& search,
+                                                 bool driving)
+{
+  o.range_tolerance = search.range_tolerance;
+  o.agreement_tolerance = search.agreement_tolerance;
+  o.fix_covariance_scale = driving ? 5.0 : 10.0;
+  if (driving)
+  {
+    o.odom_alpha2 = 0.05;
+    o.odom_alpha3 = 0.21;
+    o.odom_alpha4 = 0.1;
+  }
+  return o;
+}
+
 /// @p count people walking at random at @p speed [m/s], discs of @p radius [m].
 inline core::ObstacleGroupConfig walkers(int count, double radius, double speed)
 {

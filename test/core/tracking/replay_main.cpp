@@ -98,7 +98,7 @@ void apply(const std::string& flag, const std::string& value, Args& args)
 fdml_test::ReplayAnswers replaySeed(const Args& args, const std::shared_ptr<const core::MapRayCaster>& map, int seed)
 {
   const core::LocalizerOptions search = fdml_test::globalSearchOptions(120, 0.03);
-  const core::TrackerOptions o = fdml_test::replayTrackerOptions(args.tracker, search, args.patrol);
+  const core::TrackerOptions o = fdml_test::launchTrackerOptions(args.tracker, search, args.patrol);
   core::ScenarioConfig scenario = args.patrol ? fdml_test::apartmentPatrol(5) : fdml_test::demoScenario(seed);
   scenario.seed = static_cast<std::uint64_t>(seed);
   const int stride = args.patrol ? 2 : 1;

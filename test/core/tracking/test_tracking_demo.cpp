@@ -21,7 +21,7 @@ TEST(HypothesisTrackerDemo, KidnapsAmongPeopleAndChairsAreNeverAnsweredWrong)
   // brings the true place to compete.
   const auto map = core::test::loadMap("maps/apartment.poly");
   const core::LocalizerOptions search = fdml_test::globalSearchOptions(120, 0.03);  // the demo's launch
-  const core::TrackerOptions o = fdml_test::replayTrackerOptions(core::TrackerOptions(), search, false);
+  const core::TrackerOptions o = fdml_test::launchTrackerOptions(core::TrackerOptions(), search, false);
   const std::pair<std::uint64_t, int> runs[] = { { 18, 53 }, { 22, 49 }, { 25, 51 }, { 39, 59 } };
   int answered = 0, kidnaps = 0;
   for (const auto& run : runs)
@@ -47,7 +47,7 @@ TEST(HypothesisTrackerPatrol, AnAnswerOnlyJustReachingKPrimeIsSearchedAroundMore
   // Such a hypothesis's box now reaches at least 3 times the smallest in heading, 2 in position.
   const auto map = core::test::loadMap("maps/apartment.poly");
   const core::LocalizerOptions search = fdml_test::globalSearchOptions(120, 0.03);
-  const core::TrackerOptions o = fdml_test::replayTrackerOptions(core::TrackerOptions(), search, true);
+  const core::TrackerOptions o = fdml_test::launchTrackerOptions(core::TrackerOptions(), search, true);
   core::ScenarioConfig patrol = fdml_test::apartmentPatrol(5);
   patrol.seed = 14;
   const fdml_test::ReplayAnswers answers = fdml_test::replayKidnaps(patrol, map, 10, 2, o, search, 21, 30.0, 5.0);

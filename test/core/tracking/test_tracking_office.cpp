@@ -40,18 +40,6 @@ core::ScenarioConfig officeMoving(std::uint64_t seed)
   return c;
 }
 
-/// The launch's tracker: the simulated odometry's noise, range_tolerance 0.03 m, k / stride = 5.
-core::TrackerOptions officeTracker()
-{
-  core::TrackerOptions o;
-  o.odom_alpha2 = 0.05;
-  o.odom_alpha3 = 0.21;
-  o.odom_alpha4 = 0.1;
-  o.range_tolerance = 0.03;
-  o.fix_covariance_scale = 5.0;
-  return o;
-}
-
 struct OfficeRun
 {
   int updates = 0, published = 0, wrong = 0;
@@ -66,8 +54,10 @@ OfficeRun driveOffice(std::uint64_t seed, double duration)
 {
   const auto map = core::test::loadMap("maps/office.poly");
   Drive drive(fdml_test::simulate(officeMoving(seed), map), 10, 2);
-  core::HypothesisTracker tracker(map, officeTracker());
-  core::Localizer global(map, fdml_test::globalSearchOptions(120, 0.03));
+  const core::LocalizerOptions search = fdml_test::globalSearchOptions(120, 0.03);
+  // The launch's tracker: the simulated odometry's noise, range_tolerance 0.03 m, k / stride = 5.
+  core::HypothesisTracker tracker(map, fdml_test::launchTrackerOptions(core::TrackerOptions(), search, true));
+  core::Localizer global(map, search);
   OfficeRun run;
   DriveBatch batch;
   core::Result pending;

@@ -194,7 +194,7 @@ std::vector<bool> Refiner::hypothesisAndInliers() const
   return use;
 }
 
-void Refiner::enumerate(const std::vector<Pose2>& poses, double gate, double reach)
+void Refiner::enumerate(const std::vector<Pose2>& poses, double gate, double reach, const Deadline& deadline)
 {
   const std::vector<bool> use = hypothesisAndInliers();
   if (countUsed(use) < 3)
@@ -215,7 +215,7 @@ void Refiner::enumerate(const std::vector<Pose2>& poses, double gate, double rea
   const std::size_t n = agreeing.size();
   const std::size_t polishes = std::min(n, kRegionPolishes);
   collecting_ = true;
-  for (std::size_t j = 0; j < polishes; ++j)
+  for (std::size_t j = 0; j < polishes && !deadline.passed(); ++j)
   {
     consider(polish(agreeing[j * n / polishes], use, settings_.agreement_tolerance));
   }
@@ -246,7 +246,7 @@ bool anotherOptimum(const Candidate& best, const std::vector<Candidate>& ties, c
 std::vector<Candidate> polishTiedCandidate(const MapRayCaster& map, const std::vector<Reading>& readings,
                                            const SearchSeed& seed, const RefinementSettings& settings,
                                            const LocalizerOptions& options, double gate, bool enumerate,
-                                           Candidate& candidate)
+                                           const Deadline& deadline, Candidate& candidate)
 {
   std::vector<Candidate> ties;
   Candidate polished = refineSeed(map, candidate.pose, readings, seed.hypothesis, settings,
@@ -255,7 +255,7 @@ std::vector<Candidate> polishTiedCandidate(const MapRayCaster& map, const std::v
   {
     const std::vector<Pose2> none;
     Refiner refiner(map, polished.pose, readings, seed.hypothesis, settings, none);
-    refiner.enumerate(*seed.region_poses, gate, 0.5 * settings.multi_start_step);
+    refiner.enumerate(*seed.region_poses, gate, 0.5 * settings.multi_start_step, deadline);
     const std::vector<Candidate> more = refiner.ties();
     std::copy(more.begin(), more.end(), std::back_inserter(ties));
     Candidate best = refiner.candidate();

@@ -240,7 +240,7 @@ private:
         continue;
       }
       ties[j] = polishTiedCandidate(ctx_.map, ctx_.readings, seeds_[static_cast<std::size_t>(kept[j].support)], with,
-                                    options, ctx_.loose_gate, first_of_region[j] != 0, kept[j]);
+                                    options, ctx_.loose_gate, first_of_region[j] != 0, ctx_.deadline, kept[j]);
     }
     for (std::vector<Candidate>& found : ties)
     {

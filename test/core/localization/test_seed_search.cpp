@@ -1,6 +1,7 @@
 // The one robust search (seed_search.h) and the one ranking (ranking.h) serve both engines: the
 // same inputs give the same answer from either engine wherever both find the truth.
 #include "fdml_localization/core/localization/ranking.h"
+#include "fdml_localization/core/localization/seed_refiner.h"
 #include "fdml_localization/core/localization/seed_search.h"
 
 #include "localizer_test_utils.h"
@@ -102,6 +103,40 @@ TEST(SeedSearch, AutomaticKPrimeIsTheConsensusTheSeedReaches)
   EXPECT_LT(positionError(found.candidates[0].pose, truth), 1e-3);
   // Reached at the first level asked: no lower level was requested.
   EXPECT_EQ(source.calls(), 1);
+}
+
+TEST(SeedSearch, TheEnumerationOfARegionStopsAtTheDeadline)
+{
+  const auto map = test::lRoomMap();
+  const Pose2 truth(3.0, 1.0, 0.4);
+  const std::vector<Reading> readings = test::exactReadings(*map, truth, test::inPlaceOffsets(8));
+  std::vector<Pose2> region;  // a lattice of 125 poses around the truth: 2 cm, 1 deg
+  for (int i = -2; i <= 2; ++i)
+  {
+    for (int j = -2; j <= 2; ++j)
+    {
+      for (int t = -2; t <= 2; ++t)
+      {
+        region.emplace_back(truth.x + 0.02 * i, truth.y + 0.02 * j, truth.theta + 0.0175 * t);
+      }
+    }
+  }
+  const std::vector<bool> hypothesis(readings.size(), true);
+  const std::vector<Pose2> none;
+  const Pose2 start(truth.x + 0.05, truth.y, truth.theta);
+  Refiner unbounded(*map, start, readings, hypothesis, RefinementSettings(), none);
+  unbounded.enumerate(region, 0.3, 0.01, Deadline());
+  const std::vector<Candidate> reached = unbounded.ties();
+  ASSERT_FALSE(reached.empty());
+  EXPECT_LT(positionError(reached.front().pose, truth), 1e-3);
+  const Deadline spent(1e-6);
+  while (!spent.passed())
+  {
+    // the budget is spent before the enumeration starts
+  }
+  Refiner bounded(*map, start, readings, hypothesis, RefinementSettings(), none);
+  bounded.enumerate(region, 0.3, 0.01, spent);
+  EXPECT_TRUE(bounded.ties().empty());
 }
 
 TEST(Ranking, UnambiguousOnlyWithAStrictlyLargerNetConsensus)

@@ -97,8 +97,9 @@ struct LocalizerOptions
   // Adaptive engine budget.
   long max_boxes = 20000000;  ///< stop subdividing after this many boxes (>= 1000)
   /// Wall-time budget per call [s]; 0 = none. The adaptive engine's box search stops at it; the
-  /// robust search (both engines) refines no more seeds and stops lowering k' past it (the
-  /// budget counted again from its start), ranking what it found.
+  /// robust search (both engines) refines no more seeds, stops lowering k' and enumerates no
+  /// more of a region's poses past it (the budget counted again from its start), ranking what it
+  /// found.
   double deadline = 0.0;
   /// Readings with no return: constraints (the default), weak evidence, or dropped.
   NoReturnPolicy no_return = NoReturnPolicy::Constraint;

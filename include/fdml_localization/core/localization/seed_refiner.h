@@ -9,6 +9,7 @@
 
 #include "fdml_localization/core/localization/robust_search.h"
 #include "fdml_localization/core/localization/seed_search.h"
+#include "fdml_localization/core/util/stopwatch.h"
 
 #include <algorithm>
 #include <vector>
@@ -51,8 +52,8 @@ public:
   void multiStart();
   /// Polishes from each of @p poses (at most kRegionPolishes of them, spread over the list)
   /// where every reading agrees within @p gate [m], moved off walls within @p reach [m] first,
-  /// collecting what they reach for ties().
-  void enumerate(const std::vector<Pose2>& poses, double gate, double reach);
+  /// collecting what they reach for ties(); none once @p deadline has passed.
+  void enumerate(const std::vector<Pose2>& poses, double gate, double reach, const Deadline& deadline);
   Candidate candidate() const;
   std::vector<Candidate> ties() const;  ///< the optima multiStart() reached tying the best
 
@@ -100,14 +101,15 @@ private:
  *        the uniqueness margins, the region holds several optima (readings that leave the place
  *        ambiguous) and a dozen spread starts can miss some: then every pose of
  *        seed.region_poses where all readings agree within @p gate [m] is polished from too
- *        (Refiner::enumerate()). @p candidate is improved in place (its support kept), its
- *        covariance widened over the ties within the margins, both settled along continua.
+ *        (Refiner::enumerate(), until @p deadline, LocalizerOptions::deadline from the search's
+ *        start). @p candidate is improved in place (its support kept), its covariance widened over
+ *        the ties within the margins, both settled along continua.
  * @return the distinct other optima tying it, ranked, at most options.max_candidates
  */
 std::vector<Candidate> polishTiedCandidate(const MapRayCaster& map, const std::vector<Reading>& readings,
                                            const SearchSeed& seed, const RefinementSettings& settings,
                                            const LocalizerOptions& options, double gate, bool enumerate,
-                                           Candidate& candidate);
+                                           const Deadline& deadline, Candidate& candidate);
 
 }  // namespace core
 }  // namespace fdml_localization

@@ -127,8 +127,11 @@ LocalSolveOutcome localSolve(const MapRayCaster& map, const BoxOccupancy& occupa
   }
   if (found.leaves.empty())
   {
-    // No leaf may explain k' readings: say whether the prediction is contradicted or only hidden.
-    outcome.least_contradicted = evaluatePose(map, box.centre(), readings, settings.agreement_tolerance).contradicted;
+    // No leaf may explain k' readings: say whether the prediction is contradicted or only hidden,
+    // and what it explains (a place whose readings people hide keeps that much support).
+    const PoseEvaluation centre = evaluatePose(map, box.centre(), readings, settings.agreement_tolerance);
+    outcome.least_contradicted = centre.contradicted;
+    outcome.best_consensus = centre.inliers - centre.contradicted;
     return outcome;
   }
   const RefinementSettings refine = refinementOf(settings);

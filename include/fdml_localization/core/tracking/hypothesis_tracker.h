@@ -72,8 +72,9 @@ struct TrackerOptions
   /// covariance growing), none of them a conflict, >= 0
   int tolerated_misses = 20;
   /// A miss in which at least this many readings contradict every refined pose of the box
-  /// (longer than the map allows: no unknown obstacle explains them), or a fix contradicting this
-  /// many, is a conflict: the hypothesis is not published until a fix without one. >= 1
+  /// (longer than the map allows: no unknown obstacle explains them), a fix contradicting this
+  /// many, or a fix whose fused pose contradicts this many more than the fix, is a conflict: the
+  /// hypothesis is not published until a fix without one. >= 1
   int conflict_readings = 2;
   double publish_max_xy = 0.1;       ///< ... and 3 sigma of its position is at most this [m], > 0
   double publish_max_theta = 0.087;  ///< ... and 3 sigma of its heading at most this [rad], > 0
@@ -187,10 +188,11 @@ struct UpdateReport
 /// What a hint (initialpose) gave.
 struct HintOutcome
 {
-  bool accepted = false;   ///< at least one pose in the hint's box explains k' readings
-  int best_consensus = 0;  ///< the best net consensus found in the box (-k: nothing refined)
-  int min_consensus = 0;   ///< the k' required
-  int hypotheses = 0;      ///< hypotheses seeded
+  bool accepted = false;  ///< at least one pose in the hint's box explains k' readings
+  /// The best net consensus found in the box (at its centre when no pose of it may reach k')
+  int best_consensus = 0;
+  int min_consensus = 0;  ///< the k' required
+  int hypotheses = 0;     ///< hypotheses seeded
 };
 
 /// A batch of readings relative to the base at the odometry pose @p reference (the node's batch).
@@ -279,6 +281,12 @@ private:
   /// Re-solves @p h in its box; true on a fix.
   bool updateOne(Hypothesis& h, const std::vector<Reading>& readings, const Pose2& reference,
                  const LocalSolveSettings& settings, UpdateReport& report);
+  /// Carries @p h by one of @p found's fixes in @p box (chooseFix(), fused with fixNoise(),
+  /// narrowing only by onlyPlace()); the update is a conflict when the fix, or the fused pose
+  /// beyond its fix, leaves conflict_readings readings longer than the map allows, and the
+  /// fused pose's covariance then also covers the fix.
+  void takeFix(Hypothesis& h, const std::vector<Reading>& readings, const Pose2& reference, const PoseBox& box,
+               const LocalSolveOutcome& found);
   /// The covariance a new hypothesis at @p candidate starts with.
   Eigen::Matrix3d initialCovariance(const Candidate& candidate) const;
   /// The covariance of the smallest search box (box_min_xy, box_min_theta as 3 sigma).

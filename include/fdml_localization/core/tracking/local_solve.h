@@ -50,7 +50,8 @@ struct LocalSolveOutcome
   /// every box at k'): an upper bound of the consensus inside the box when the search was not
   /// truncated.
   int best_possible = 0;
-  /// The best net consensus reached by a refined pose in the box (-k when nothing was refined).
+  /// The best net consensus reached by a refined pose in the box, or at the box's centre when
+  /// the search pruned every box at k' (nothing refined).
   int best_consensus = 0;
   /// The fewest readings contradicted (longer than the map allows: no unknown obstacle explains
   /// them) at a refined pose, or at the box's centre when nothing was refined.

@@ -12,22 +12,38 @@
 
 namespace core = fdml_localization::core;
 
-TEST(HypothesisTracker, AFixContradictingReadingsIsNotPublished)
+namespace
 {
-  // Standing in the L room, ten rays; then two of them measure 0.3 m longer than the map allows
-  // (no unknown obstacle does that: a kidnap's new place). The fix still explains 8 and nets 6
-  // of 10 (k' = 6), but is in conflict: not published until a fix without one.
-  const auto map = core::test::lRoomMap();
-  const core::Pose2 pose(3.3, 1.2, -2.0);
-  const std::vector<core::Reading> exact = core::test::exactReadings(*map, pose, core::test::inPlaceOffsets(10));
-  core::HypothesisTracker tracker(map, fdml_test::driveTrackerOptions());
+/// Ten rays in place at @p pose in the L room, exact.
+std::vector<core::Reading> lRoomReadings(const core::Pose2& pose)
+{
+  return core::test::exactReadings(*core::test::lRoomMap(), pose, core::test::inPlaceOffsets(10));
+}
+
+/// A tracker (the drives' options) seeded at @p pose in the L room and updated eight times on
+/// @p readings there.
+core::HypothesisTracker trackedInLRoom(const core::Pose2& pose, const std::vector<core::Reading>& readings)
+{
+  core::HypothesisTracker tracker(core::test::lRoomMap(), fdml_test::driveTrackerOptions());
   core::Candidate start;
   start.pose = pose;
   tracker.seed({ start }, pose, 0.0);
   for (int i = 0; i < 8; ++i)
   {
-    tracker.update(exact, pose);
+    tracker.update(readings, pose);
   }
+  return tracker;
+}
+}  // namespace
+
+TEST(HypothesisTracker, AFixContradictingReadingsIsNotPublished)
+{
+  // Standing in the L room, ten rays; then two of them measure 0.3 m longer than the map allows
+  // (no unknown obstacle does that: a kidnap's new place). The fix still explains 8 and nets 6
+  // of 10 (k' = 6), but is in conflict: not published until a fix without one.
+  const core::Pose2 pose(3.3, 1.2, -2.0);
+  const std::vector<core::Reading> exact = lRoomReadings(pose);
+  core::HypothesisTracker tracker = trackedInLRoom(pose, exact);
   ASSERT_NE(tracker.clearlySupported(), nullptr);
   std::vector<core::Reading> longer = exact;
   longer[2].range += 0.3;
@@ -94,17 +110,9 @@ TEST(HypothesisTracker, AMissWherePeopleHideReadingsKeepsWhatThePredictionExplai
   // Standing in the L room, ten rays; then people shorten five of them by 0.5 m: no pose of the
   // box explains k' = 6, a miss. The prediction still explains the other five: the miss earns
   // 5 / 10 (before, an empty box earned 0 and a place alike explaining one more took the lead).
-  const auto map = core::test::lRoomMap();
   const core::Pose2 pose(3.3, 1.2, -2.0);
-  const std::vector<core::Reading> exact = core::test::exactReadings(*map, pose, core::test::inPlaceOffsets(10));
-  core::HypothesisTracker tracker(map, fdml_test::driveTrackerOptions());
-  core::Candidate start;
-  start.pose = pose;
-  tracker.seed({ start }, pose, 0.0);
-  for (int i = 0; i < 8; ++i)
-  {
-    tracker.update(exact, pose);
-  }
+  const std::vector<core::Reading> exact = lRoomReadings(pose);
+  core::HypothesisTracker tracker = trackedInLRoom(pose, exact);
   ASSERT_EQ(tracker.hypotheses().size(), 1u);
   const double before = tracker.hypotheses().front().support;
   std::vector<core::Reading> hidden = exact;

@@ -51,12 +51,34 @@ struct ReplayAnswers
   int followed_published = 0, followed_wrong = 0;
 };
 
+/// How long a replayed relocalization runs [s of simulated time].
+struct ReplayTiming
+{
+  double timeout = 30.0;  ///< at most this long from the kidnap to an answer
+  double follow = 0.0;    ///< tracking goes on this long after the answer, scored
+  /// > 0: every kidnap runs exactly this long (the answer within it, followed to its end), so the
+  /// kidnaps and the people do not depend on when the answers came: builds compare kidnap by
+  /// kidnap. Replaces timeout and follow.
+  double window = 0.0;
+
+  /// The simulated time to drive to after a kidnap at @p kidnapped, answered at @p answered (< 0:
+  /// not yet).
+  double end(double kidnapped, double answered) const
+  {
+    return window > 0.0 ? kidnapped + window : answered < 0.0 ? kidnapped + timeout : answered + follow;
+  }
+  bool following() const
+  {
+    return follow > 0.0 || window > 0.0;
+  }
+};
+
 /// One relocalization after a kidnap at simulated time @p kidnapped [s]: searches and updates on
-/// the batches of readings all taken after it, for at most @p timeout [s]; then, for @p follow [s]
-/// after the answer, the same updates go on (tracking, as the node does) and what they publish is
-/// scored.
-inline void relocalize(Drive& drive, double kidnapped, double timeout, core::HypothesisTracker& tracker,
-                       core::Localizer& global, ReplayAnswers* answers, double follow = 0.0)
+/// the batches of readings all taken after it until an answer (ReplayTiming); then, while
+/// @p timing follows, the same updates go on (tracking, as the node does) and what they publish
+/// is scored.
+inline void relocalize(Drive& drive, double kidnapped, const ReplayTiming& timing, core::HypothesisTracker& tracker,
+                       core::Localizer& global, ReplayAnswers* answers)
 {
   tracker.clear();
   core::Result found;
@@ -65,7 +87,7 @@ inline void relocalize(Drive& drive, double kidnapped, double timeout, core::Hyp
   int since_global = 0;
   DriveBatch batch;
   double answered = -1.0;  // simulated time of the answer [s]
-  while (drive.next(&batch, answered < 0.0 ? kidnapped + timeout : answered + follow))
+  while (drive.next(&batch, timing.end(kidnapped, answered)))
   {
     if (batch.start_time <= kidnapped)
     {
@@ -98,7 +120,7 @@ inline void relocalize(Drive& drive, double kidnapped, double timeout, core::Hyp
       answers->right += error.empty() ? 1 : 0;
       answers->seconds += batch.time - kidnapped;
       answered = batch.time;
-      if (follow <= 0.0)
+      if (!timing.following())
       {
         return;
       }
@@ -107,13 +129,12 @@ inline void relocalize(Drive& drive, double kidnapped, double timeout, core::Hyp
   answers->unanswered += answered < 0.0 ? 1 : 0;
 }
 
-/// @p kidnaps relocalizations (each allowed @p timeout [s], then followed for @p follow [s]) in
-/// @p scenario on @p map, batches of @p k readings sliding by @p stride (formed per reading, as
-/// the node forms them), @p tracker and @p search the node's tracker and tracking global search.
+/// @p kidnaps relocalizations (each as long as @p timing) in @p scenario on @p map, batches of
+/// @p k readings sliding by @p stride (formed per reading, as the node forms them), @p tracker
+/// and @p search the node's tracker and tracking global search.
 inline ReplayAnswers replayKidnaps(const core::ScenarioConfig& scenario, std::shared_ptr<const core::MapRayCaster> map,
                                    int k, int stride, const core::TrackerOptions& tracker_options,
-                                   const core::LocalizerOptions& search, int kidnaps, double timeout,
-                                   double follow = 0.0)
+                                   const core::LocalizerOptions& search, int kidnaps, const ReplayTiming& timing)
 {
   Drive drive(simulate(scenario, map), k, stride, true);
   core::HypothesisTracker tracker(map, tracker_options);
@@ -127,7 +148,7 @@ inline ReplayAnswers replayKidnaps(const core::ScenarioConfig& scenario, std::sh
     {
       throw std::runtime_error("kidnap: " + message);
     }
-    relocalize(drive, drive.sim().time(), timeout, tracker, global, &answers, follow);
+    relocalize(drive, drive.sim().time(), timing, tracker, global, &answers);
   }
   return answers;
 }

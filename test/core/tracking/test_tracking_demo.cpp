@@ -27,7 +27,7 @@ TEST(HypothesisTrackerDemo, KidnapsAmongPeopleAndChairsAreNeverAnsweredWrong)
   for (const auto& run : runs)
   {
     const fdml_test::ReplayAnswers answers =
-        fdml_test::replayKidnaps(fdml_test::demoScenario(run.first), map, 10, 1, o, search, run.second, 30.0);
+        fdml_test::replayKidnaps(fdml_test::demoScenario(run.first), map, 10, 1, o, search, run.second, {});
     EXPECT_EQ(answers.wrong, 0) << "seed " << run.first << ": " << answers.first_wrong;
     answered += answers.right + answers.wrong;
     kidnaps += run.second;
@@ -50,7 +50,7 @@ TEST(HypothesisTrackerPatrol, AnAnswerOnlyJustReachingKPrimeIsSearchedAroundMore
   const core::TrackerOptions o = fdml_test::launchTrackerOptions(core::TrackerOptions(), search, true);
   core::ScenarioConfig patrol = fdml_test::apartmentPatrol(5);
   patrol.seed = 14;
-  const fdml_test::ReplayAnswers answers = fdml_test::replayKidnaps(patrol, map, 10, 2, o, search, 21, 30.0, 5.0);
+  const fdml_test::ReplayAnswers answers = fdml_test::replayKidnaps(patrol, map, 10, 2, o, search, 21, { 30.0, 5.0 });
   EXPECT_EQ(answers.wrong, 0) << answers.first_wrong;
   EXPECT_EQ(answers.followed_wrong, 0);
   EXPECT_EQ(answers.right, 21);

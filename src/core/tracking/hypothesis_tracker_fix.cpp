@@ -78,12 +78,13 @@ void HypothesisTracker::takeFix(Hypothesis& h, const std::vector<Reading>& readi
   h.covariance = onlyPlace(h.covariance, box, fused, readings, fix) ? fused.covariance : h.covariance;
   // The pose must explain what its fix explains. Where it leaves readings the fix explains longer
   // than the map allows, the prediction held it where the readings refute it (a heading 5.8 deg
-  // off, precise from fixes one sensor alone turned, while the front ray passed a door 2.3 m
-  // beyond the jamb the pose put it on): it is wrong, withheld, and no surer than its distance
-  // from the fix.
-  const int refuted =
-      evaluatePose(*map_, fused.pose, readings, options_.agreement_tolerance).contradicted - fix.contradicted;
-  if (refuted >= options_.conflict_readings)
+  // off, precise from fixes one sensor alone turned, its front ray hitting the hall's wall 2.3 m
+  // short of every front reading that passed the door): it is wrong, withheld, and no surer
+  // than its distance from the fix.
+  const bool refuted =
+      evaluatePose(*map_, fused.pose, readings, options_.agreement_tolerance).contradicted - fix.contradicted >=
+      options_.conflict_readings;
+  if (refuted)
   {
     const Eigen::Vector3d d = poseDifference(fix.pose, fused.pose);
     h.covariance += d * d.transpose();
@@ -94,7 +95,7 @@ void HypothesisTracker::takeFix(Hypothesis& h, const std::vector<Reading>& readi
   // A fix that leaves readings longer than the map allows is in conflict too: after a kidnap,
   // the old place along a corridor explained 8 of 10 new readings and contradicted 2, and was
   // published again for 0.4 s.
-  h.conflicted = fix.contradicted >= options_.conflict_readings || refuted >= options_.conflict_readings;
+  h.conflicted = fix.contradicted >= options_.conflict_readings || refuted;
   ++h.fixes;
   h.support = options_.support_decay * h.support + static_cast<double>(netConsensus(fix)) / readings.size();
   h.last_fix = fix;

@@ -1,13 +1,16 @@
-// settleInNearBasins() (robust_search.h): the candidates' last polish, from a fine lattice around
-// them, where a ray passing a vertex splits the cost into basins a centimetre wide.
+// settleInNearBasins() (robust_search.h): the candidates' last polish, escapes leaving out pairs
+// of directions, then a fine lattice around them, where a ray passing a vertex splits the cost into
+// basins a centimetre wide.
 #include "fdml_localization/core/localization/ranking.h"
 #include "fdml_localization/core/localization/region_starts.h"
 #include "fdml_localization/core/localization/robust_search.h"
+#include "fdml_localization/core/localization/seed_refiner.h"
 
 #include <omp.h>
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <vector>
 
 namespace fdml_localization
@@ -96,6 +99,42 @@ void settleInNearBasin(const MapRayCaster& map, const std::vector<Reading>& read
   }
 }
 
+/// Two readings crossing edges between @p candidate (short of exact) and its basin's optimum hold
+/// every polish on all of its readings away from it, and leaving out either alone explains fewer:
+/// what the escapes reach leaving out pairs of readings too (RefinementSettings::escape_pairs),
+/// when that is better, replaces @p candidate within its uniqueness margins and goes to
+/// @p elsewhere beyond them (another place, which @p candidate still is). Verification seed 865:
+/// driving, the front rays grazed an edge at the exact truth and the right one crossed a corner;
+/// the polish stopped 5.2 cm and 1.25 deg from the truth.
+void escapeInPairs(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
+                   const RefinementSettings& settings, Candidate& candidate, std::vector<Candidate>& elsewhere)
+{
+  if (candidate.rms_residual < kExactRms)
+  {
+    return;
+  }
+  RefinementSettings pairs = settings;
+  pairs.escape_pairs = true;
+  const std::vector<Pose2> none;
+  Refiner refiner(map, candidate.pose, readings, candidate.inlier_mask, pairs, none);
+  refiner.escapes();
+  Candidate escaped = refiner.candidate();
+  if (!betterCandidate(escaped, candidate))
+  {
+    return;
+  }
+  escaped.support = candidate.support;
+  const Eigen::Vector3d d = poseDifference(escaped.pose, candidate.pose);
+  if (d.head<2>().norm() > options.uniqueness_distance || std::abs(d.z()) > options.uniqueness_angle)
+  {
+    widenAlongContinua(map, readings, settings.noise_sigma, escaped);
+    elsewhere.push_back(std::move(escaped));
+    return;
+  }
+  escaped.covariance = candidate.covariance;  // widened along continua, tied duplicates absorbed
+  candidate = std::move(escaped);
+}
+
 /// Widens the covariance of an exact @p candidate near an edge of the cost (nearAnEdge()) to cover the exact places
 /// polished from a lattice kTwinSteps steps (@p step_xy [m], @p step_theta [rad]) around it that tie it within the
 /// uniqueness margins (absorbTiedDuplicates()): the engine returns one of such twins, and the readings cannot tell
@@ -142,11 +181,18 @@ void settleInNearBasins(const MapRayCaster& map, const std::vector<Reading>& rea
     ++tied;
   }
   const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+  std::vector<std::vector<Candidate>> elsewhere(static_cast<std::size_t>(tied));
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (tied >= 2)
   for (long j = 0; j < tied; ++j)
   {
+    escapeInPairs(map, readings, options, settings, candidates[static_cast<std::size_t>(j)],
+                  elsewhere[static_cast<std::size_t>(j)]);
     settleInNearBasin(map, readings, settings, step_xy, step_theta, candidates[static_cast<std::size_t>(j)]);
     absorbExactTwins(map, readings, options, settings, step_xy, step_theta, candidates[static_cast<std::size_t>(j)]);
+  }
+  for (std::vector<Candidate>& found : elsewhere)
+  {
+    std::move(found.begin(), found.end(), std::back_inserter(candidates));
   }
   candidates = rankAndDeduplicate(std::move(candidates), options.uniqueness_distance, options.uniqueness_angle,
                                   options.max_candidates);

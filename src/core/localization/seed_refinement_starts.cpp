@@ -77,8 +77,9 @@ std::vector<bool> Refiner::withoutParallel(int drop) const
 }
 
 /// The readings to leave out in one escape round: the worst one, then those passing nearest a
-/// vertex; empty when fewer than 4 finite inliers remain.
-std::vector<int> Refiner::escapeTries() const
+/// vertex (with @p one_per_direction, none parallel to one before it); empty when fewer than 4
+/// finite inliers remain.
+std::vector<int> Refiner::escapeTries(bool one_per_direction) const
 {
   std::vector<int> order;
   for (std::size_t i = 0; i < readings_.size(); ++i)
@@ -98,7 +99,11 @@ std::vector<int> Refiner::escapeTries() const
   std::sort(order.begin(), order.end(), [&](int a, int b) { return margins[a] < margins[b]; });
   for (std::size_t j = 0; j < order.size() && static_cast<int>(tries.size()) < settings_.escape_tries; ++j)
   {
-    if (order[j] != worst)
+    const Reading& reading = readings_[static_cast<std::size_t>(order[j])];
+    const bool repeated = std::any_of(tries.begin(), tries.end(), [&](int t) {
+      return t == order[j] || (one_per_direction && parallelRays(readings_[static_cast<std::size_t>(t)], reading));
+    });
+    if (!repeated)
     {
       tries.push_back(order[j]);
     }
@@ -117,7 +122,7 @@ void Refiner::escapes()
   for (int attempt = 0;
        attempt < settings_.max_escapes && best_.rms > 1e-9 && best_.inliers >= settings_.escape_min_inliers; ++attempt)
   {
-    const std::vector<int> tries = escapeTries();
+    const std::vector<int> tries = escapeTries(false);
     bool improved = false;
     for (std::size_t j = 0; j < tries.size() && !improved; ++j)
     {
@@ -130,12 +135,36 @@ void Refiner::escapes()
         improved = consider(polish(best_pose_, rest, 0.0));
       }
     }
+    improved = improved || (settings_.escape_pairs && escapePairs());
     if (!improved)
     {
       break;
     }
     polishRounds();
   }
+}
+
+bool Refiner::escapePairs()
+{
+  const std::vector<int> tries = escapeTries(true);
+  for (std::size_t j = 0; j < tries.size(); ++j)
+  {
+    const std::vector<bool> first = withoutParallel(tries[j]);
+    for (std::size_t l = j + 1; l < tries.size(); ++l)
+    {
+      const Reading& other = readings_[static_cast<std::size_t>(tries[l])];
+      std::vector<bool> rest = first;
+      for (std::size_t i = 0; i < readings_.size(); ++i)
+      {
+        rest[i] = rest[i] && !parallelRays(readings_[i], other);
+      }
+      if (countUsed(rest) >= 3 && consider(polish(best_pose_, rest, 0.0)))
+      {
+        return true;
+      }
+    }
+  }
+  return false;
 }
 
 /// The polish is a local descent: the optimum of the region can lie in another basin of the

@@ -167,6 +167,10 @@ struct RefinementSettings
                                           ///< a lattice around the best pose; 0 = none
   double multi_start_step = 0.05;         ///< lattice step of the multi-start in x, y [m]
   double multi_start_angle_step = 0.02;   ///< ... and in theta [rad]
+  /// A leave-one-out round that improves nothing then leaves out pairs of directions (of the
+  /// readings it tries, one per direction, each with its parallel readings): two rays crossing
+  /// edges between the pose and the optimum.
+  bool escape_pairs = false;
   /// With multi_start: run it even from an exact pose, and return every distinct optimum it
   /// reaches with the best one's net consensus (refineSeed()'s @p ties): several exact poses
   /// can share one region (a mirror heading a few cells away).
@@ -253,20 +257,19 @@ Candidate polishedFrom(const MapRayCaster& map, const std::vector<Reading>& read
 
 /**
  * @brief The last polish of the candidates tied at the best net consensus (both engines, after
- *        the region fill), so that each reaches the least residual of its place: polishedFrom()
- *        the 26 poses of a lattice around it, half the range tolerance tau apart in x and y [m]
- *        and that over the readings' median finite range in the heading [rad] (at most a quarter
- *        of the uniqueness angle). A better pose (betterCandidate()) replaces it, its covariance
- *        kept; where it lies half a step away or more, the lattice is laid again around it
- *        (three times at most). An exact candidate (RMS below 1 um) stays, and so does one
- *        whose finite inliers' rays pass no vertex within twice the step (plus the heading step
- *        times the reach along the ray and the sensor's offset, vertexMargins()) and that has no
- *        cone reading: the cost is smooth around it. The piecewise-smooth
- *        cost has a basin per set of walls the rays hit, and the seeds' multi-start lattice is a
- *        cell wide: in the paper's floor plan scaled by 0.25, three rays hit a wall's jog 4 mm in
- *        front of the wall they hit from the truth, and the best candidate stopped 1.15 cm and
- *        0.52 deg from it (RMS 4.2 mm against 0). An exact candidate near such an edge instead
- *        has its covariance widened to cover the exact places polished from a lattice four steps
+ *        the region fill), so that each reaches the least residual of its place. First the
+ *        escapes of refineSeed() again, leaving out pairs of directions too (escape_pairs): a
+ *        better pose within the uniqueness margins replaces the candidate, one beyond them is
+ *        added as another candidate. Then polishedFrom() the 26 poses of a lattice around it, half the range tolerance
+ * tau apart in x and y [m] and that over the readings' median finite range in the heading [rad] (at most a quarter of
+ * the uniqueness angle). A better pose (betterCandidate()) replaces it, its covariance kept; where it lies half a step
+ * away or more, the lattice is laid again around it (three times at most). An exact candidate (RMS below 1 um) stays,
+ * and so does one whose finite inliers' rays pass no vertex within twice the step (plus the heading step times the
+ * reach along the ray and the sensor's offset, vertexMargins()) and that has no cone reading: the cost is smooth around
+ * it. The piecewise-smooth cost has a basin per set of walls the rays hit, and the seeds' multi-start lattice is a cell
+ * wide: in the paper's floor plan scaled by 0.25, three rays hit a wall's jog 4 mm in front of the wall they hit from
+ * the truth, and the best candidate stopped 1.15 cm and 0.52 deg from it (RMS 4.2 mm against 0). An exact candidate
+ * near such an edge instead has its covariance widened to cover the exact places polished from a lattice four steps
  *        wide around it that tie it within the uniqueness margins (absorbTiedDuplicates()): two
  *        exact places 4.8 cm and 2.5 deg apart, or 3.1 deg apart where a cone's edge sweeps a wall,
  *        and the engine found the one the readings did not come from (verification seeds 815,

@@ -78,7 +78,10 @@ private:
   std::vector<bool> finiteInliers(int drop) const;
   /// finiteInliers() without reading @p drop nor the others pointing its way (parallelRays()).
   std::vector<bool> withoutParallel(int drop) const;
-  std::vector<int> escapeTries() const;
+  std::vector<int> escapeTries(bool one_per_direction) const;
+  /// Leaves out each pair of escapeTries(true), with their parallel siblings; true at the first
+  /// improvement.
+  bool escapePairs();
 
   const MapRayCaster& map_;
   const Pose2 seed_;

@@ -87,7 +87,7 @@ private:
   const Pose2 seed_;
   const std::vector<Reading>& readings_;
   const std::vector<bool>& hypothesis_;
-  const RefinementSettings& settings_;
+  const RefinementSettings settings_;  ///< a copy: a caller may pass a temporary
   const std::vector<Pose2>& region_starts_;
   Pose2 best_pose_;
   PoseEvaluation best_;

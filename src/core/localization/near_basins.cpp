@@ -124,8 +124,7 @@ void escapeInPairs(const MapRayCaster& map, const std::vector<Reading>& readings
     return;
   }
   escaped.support = candidate.support;
-  const Eigen::Vector3d d = poseDifference(escaped.pose, candidate.pose);
-  if (d.head<2>().norm() > options.uniqueness_distance || std::abs(d.z()) > options.uniqueness_angle)
+  if (!withinMargins(escaped.pose, candidate.pose, options.uniqueness_distance, options.uniqueness_angle))
   {
     widenAlongContinua(map, readings, settings.noise_sigma, escaped);
     elsewhere.push_back(std::move(escaped));

@@ -32,6 +32,11 @@ bool exactTie(const Candidate& a, const Candidate& b)
          b.rms_residual < kExactRms;
 }
 
+bool withinMargins(const Pose2& a, const Pose2& b, double distance, double angle)
+{
+  return std::hypot(a.x - b.x, a.y - b.y) < distance && std::abs(angleDiff(a.theta, b.theta)) < angle;
+}
+
 std::vector<Candidate> rankAndDeduplicate(std::vector<Candidate> candidates, double distance, double angle,
                                           int max_candidates)
 {
@@ -43,10 +48,8 @@ std::vector<Candidate> rankAndDeduplicate(std::vector<Candidate> candidates, dou
     {
       break;
     }
-    const bool duplicate = std::any_of(kept.begin(), kept.end(), [&](const Candidate& k) {
-      return std::hypot(c.pose.x - k.pose.x, c.pose.y - k.pose.y) < distance &&
-             std::abs(angleDiff(c.pose.theta, k.pose.theta)) < angle;
-    });
+    const bool duplicate = std::any_of(
+        kept.begin(), kept.end(), [&](const Candidate& k) { return withinMargins(c.pose, k.pose, distance, angle); });
     if (!duplicate)
     {
       kept.push_back(std::move(c));
@@ -62,11 +65,11 @@ void absorbTiedDuplicates(const std::vector<Candidate>& all, double distance, do
   {
     for (Candidate& k : kept)
     {
-      const Eigen::Vector3d d = poseDifference(c.pose, k.pose);
-      if (d.head<2>().norm() >= distance || std::abs(d(2)) >= angle)
+      if (!withinMargins(c.pose, k.pose, distance, angle))
       {
         continue;
       }
+      const Eigen::Vector3d d = poseDifference(c.pose, k.pose);
       const double mahalanobis2 = d.dot(k.covariance.ldlt().solve(d));
       if (netConsensus(c) == netConsensus(k) && c.rms_residual <= k.rms_residual + noise && !(mahalanobis2 <= 9.0))
       {

@@ -152,11 +152,11 @@ bool Refiner::escapePairs()
     const std::vector<bool> first = withoutParallel(tries[j]);
     for (std::size_t l = j + 1; l < tries.size(); ++l)
     {
-      const Reading& other = readings_[static_cast<std::size_t>(tries[l])];
       std::vector<bool> rest = first;
-      for (std::size_t i = 0; i < readings_.size(); ++i)
+      const std::vector<bool> second = withoutParallel(tries[l]);
+      for (std::size_t i = 0; i < rest.size(); ++i)
       {
-        rest[i] = rest[i] && !parallelRays(readings_[i], other);
+        rest[i] = rest[i] && second[i];
       }
       if (countUsed(rest) >= 3 && consider(polish(best_pose_, rest, 0.0)))
       {
@@ -266,8 +266,7 @@ namespace
 bool anotherOptimum(const Candidate& best, const std::vector<Candidate>& ties, const LocalizerOptions& options)
 {
   return std::any_of(ties.begin(), ties.end(), [&](const Candidate& tie) {
-    return (tie.pose.position() - best.pose.position()).norm() > options.uniqueness_distance ||
-           std::abs(angleDiff(tie.pose.theta, best.pose.theta)) > options.uniqueness_angle;
+    return !withinMargins(tie.pose, best.pose, options.uniqueness_distance, options.uniqueness_angle);
   });
 }
 }  // namespace

@@ -41,6 +41,10 @@ bool betterCandidate(const Candidate& a, const Candidate& b);
 /// below kExactRms (what orders them then is the rounding of their polish).
 bool exactTie(const Candidate& a, const Candidate& b);
 
+/// True when @p a and @p b are one place: closer than @p distance [m] in position and than
+/// @p angle [rad] in heading (the uniqueness margins; rankAndDeduplicate() keeps one of them).
+bool withinMargins(const Pose2& a, const Pose2& b, double distance, double angle);
+
 /**
  * @brief Sorts best first and drops every candidate closer than (@p distance [m], @p angle
  *        [rad]) to a better one kept before it; keeps at most @p max_candidates.

@@ -256,24 +256,27 @@ Candidate polishedFrom(const MapRayCaster& map, const std::vector<Reading>& read
                        const RefinementSettings& settings, const Candidate& candidate, const Pose2& start);
 
 /**
- * @brief The last polish of the candidates tied at the best net consensus (both engines, after
- *        the region fill), so that each reaches the least residual of its place. First the
- *        escapes of refineSeed() again, leaving out pairs of directions too (escape_pairs): a
- *        better pose within the uniqueness margins replaces the candidate, one beyond them is
- *        added as another candidate. Then polishedFrom() the 26 poses of a lattice around it, half the range tolerance
- * tau apart in x and y [m] and that over the readings' median finite range in the heading [rad] (at most a quarter of
- * the uniqueness angle). A better pose (betterCandidate()) replaces it, its covariance kept; where it lies half a step
- * away or more, the lattice is laid again around it (three times at most). An exact candidate (RMS below 1 um) stays,
- * and so does one whose finite inliers' rays pass no vertex within twice the step (plus the heading step times the
- * reach along the ray and the sensor's offset, vertexMargins()) and that has no cone reading: the cost is smooth around
- * it. The piecewise-smooth cost has a basin per set of walls the rays hit, and the seeds' multi-start lattice is a cell
- * wide: in the paper's floor plan scaled by 0.25, three rays hit a wall's jog 4 mm in front of the wall they hit from
- * the truth, and the best candidate stopped 1.15 cm and 0.52 deg from it (RMS 4.2 mm against 0). An exact candidate
- * near such an edge instead has its covariance widened to cover the exact places polished from a lattice four steps
- *        wide around it that tie it within the uniqueness margins (absorbTiedDuplicates()): two
- *        exact places 4.8 cm and 2.5 deg apart, or 3.1 deg apart where a cone's edge sweeps a wall,
- *        and the engine found the one the readings did not come from (verification seeds 815,
- *        812). The candidates are ranked and de-duplicated again.
+ * @brief The last polish of the candidates tied at the best net consensus (both engines, after the
+ *        region fill), so that each reaches the least residual of its place. First the escapes of
+ *        refineSeed() again, leaving out pairs of directions too (escape_pairs): a better pose
+ *        within the uniqueness margins replaces the candidate, one beyond them is added as another
+ *        candidate. Then polishedFrom() the 26 poses of a lattice around it, half the range
+ *        tolerance tau apart in x and y [m] and that over the readings' median finite range in the
+ *        heading [rad] (at most a quarter of the uniqueness angle). A better pose
+ *        (betterCandidate()) replaces it, its covariance kept; where it lies half a step away or
+ *        more, the lattice is laid again around it (three times at most). An exact candidate (RMS
+ *        below 1 um) stays, and so does one whose finite inliers' rays pass no vertex within twice
+ *        the step (plus the heading step times the reach along the ray and the sensor's offset,
+ *        vertexMargins()) and that has no cone reading: the cost is smooth around it. The
+ *        piecewise-smooth cost has a basin per set of walls the rays hit, and the seeds'
+ *        multi-start lattice is a cell wide: in the paper's floor plan scaled by 0.25, three rays
+ *        hit a wall's jog 4 mm in front of the wall they hit from the truth, and the best candidate
+ *        stopped 1.15 cm and 0.52 deg from it (RMS 4.2 mm against 0). An exact candidate near such
+ *        an edge instead has its covariance widened to cover the exact places polished from a
+ *        lattice four steps wide around it that tie it within the uniqueness margins
+ *        (absorbTiedDuplicates()): two exact places 4.8 cm and 2.5 deg apart, or 3.1 deg apart
+ *        where a cone's edge sweeps a wall, and the engine found the one the readings did not come
+ *        from (verification seeds 815, 812). The candidates are ranked and de-duplicated again.
  * @param options range_tolerance, the uniqueness margins, max_candidates and threads
  * @param settings the polish's eps, noise_sigma and max_iterations
  * @param candidates ranked (rankAndDeduplicate()), the best first

@@ -20,6 +20,14 @@ namespace
 {
 /// Residual [m] charged to a ray that leaves free space or misses, during the polish.
 constexpr double kPenaltyResidual = 1.0;
+/// A step shorter than this [m], [rad] ends the polish: the pose has converged. A damping (LM
+/// lambda) beyond kStartDamping ends it, and beyond kCrawlDamping once a step is taken: a tenth of
+/// Gauss-Newton's step still fails, so the pose is pressed against a depth discontinuity (a ray
+/// about to reach another wall) the model cannot see, where descent crawls micrometres a step.
+constexpr double kConvergedStep = 1e-8;
+constexpr double kConvergedTurn = 1e-9;
+constexpr double kCrawlDamping = 10.0;
+constexpr double kStartDamping = 1e8;
 
 /// One reading's residual and its derivative with respect to (x, y, theta).
 struct ResidualRow
@@ -295,7 +303,8 @@ PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std:
   System sys = buildSystem(map, out.pose, readings, mounts, use, robust_scale, hints);
   addPrior(sys, out.pose, prior, prior_weight);
   double lambda = 1e-3;
-  for (int iter = 0; iter < max_iterations && lambda <= 1e8; ++iter)
+  bool moved = false;
+  for (int iter = 0; iter < max_iterations && lambda <= (moved ? kCrawlDamping : kStartDamping); ++iter)
   {
     out.iterations = iter + 1;
     Eigen::Matrix3d a = sys.h;
@@ -310,15 +319,16 @@ PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std:
     const Pose2 trial = step(out.pose, delta);
     System next = buildSystem(map, trial, readings, mounts, use, robust_scale, hints);
     addPrior(next, trial, prior, prior_weight);
-    if (next.cost >= sys.cost)
+    const bool converged = delta.head<2>().norm() < kConvergedStep && std::abs(delta(2)) < kConvergedTurn;
+    const bool better = next.cost < sys.cost;
+    if (better)
     {
-      lambda *= 4.0;
-      continue;
+      out.pose = trial;
+      sys = next;
+      moved = true;
     }
-    out.pose = trial;
-    sys = next;
-    lambda = std::max(lambda / 3.0, 1e-9);
-    if (delta.head<2>().norm() < 1e-8 && std::abs(delta(2)) < 1e-9)
+    lambda = better ? std::max(lambda / 3.0, 1e-9) : 4.0 * lambda;
+    if (converged)
     {
       break;
     }

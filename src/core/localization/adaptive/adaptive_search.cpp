@@ -118,6 +118,32 @@ bool nearerEverywhere(const MapRayCaster& map, const Reading& reading, const Pos
   return oneEdgeStopsEveryRay(map, sensors, t0, t1, limit) ||
          (reading.half_angle > 0.0 && coneCertainlyNearer(map, reading, box, limit));
 }
+
+/// readingMayExplain() with the reading's arcs over the box's headings: @p sensor_arc, the
+/// rotatedArcBounds() of its sensor's offset, and @p hit_arc, its hitArcBounds().
+bool mayExplainWithin(const MapRayCaster& map, const Reading& reading, const PoseBox& box, const Box2& sensor_arc,
+                      const Box2& hit_arc, double range_tolerance)
+{
+  Box2 positions;
+  positions.extend(Vec2(box.x0, box.y0));
+  positions.extend(Vec2(box.x1, box.y1));
+  const Pose2& g = reading.offset;
+  const Box2 sensors = sweep(positions, sensor_arc, 0.0);
+  // The sensor must be in free space somewhere in the box (for a sensor at the base origin the
+  // caller's robot-position test already says so).
+  if ((g.x != 0.0 || g.y != 0.0) && outsideFreeSpace(map, sensors))
+  {
+    return false;
+  }
+  if (!std::isfinite(reading.range))
+  {
+    // A no-return reading agrees when nothing is nearer than max_range - tau.
+    return !nearerEverywhere(map, reading, box, sensors, reading.max_range - range_tolerance);
+  }
+  // Some edge point where the reading ends, and not something nearer for every pose.
+  return map.grid().anySegmentInBox(sweep(positions, hit_arc, range_tolerance)) &&
+         !nearerEverywhere(map, reading, box, sensors, reading.range - range_tolerance);
+}
 }  // namespace
 
 Box2 rotatedArcBounds(const Vec2& v, double t0, double t1)
@@ -165,25 +191,9 @@ Box2 hitArcBounds(const Reading& reading, double t0, double t1)
 
 bool readingMayExplain(const MapRayCaster& map, const Reading& reading, const PoseBox& box, double range_tolerance)
 {
-  Box2 positions;
-  positions.extend(Vec2(box.x0, box.y0));
-  positions.extend(Vec2(box.x1, box.y1));
   const Pose2& g = reading.offset;
-  const Box2 sensors = sweep(positions, rotatedArcBounds(Vec2(g.x, g.y), box.t0, box.t1), 0.0);
-  // The sensor must be in free space somewhere in the box (for a sensor at the base origin the
-  // caller's robot-position test already says so).
-  if ((g.x != 0.0 || g.y != 0.0) && outsideFreeSpace(map, sensors))
-  {
-    return false;
-  }
-  if (!std::isfinite(reading.range))
-  {
-    // A no-return reading agrees when nothing is nearer than max_range - tau.
-    return !nearerEverywhere(map, reading, box, sensors, reading.max_range - range_tolerance);
-  }
-  // Some edge point where the reading ends, and not something nearer for every pose.
-  return map.grid().anySegmentInBox(sweep(positions, hitArcBounds(reading, box.t0, box.t1), range_tolerance)) &&
-         !nearerEverywhere(map, reading, box, sensors, reading.range - range_tolerance);
+  return mayExplainWithin(map, reading, box, rotatedArcBounds(Vec2(g.x, g.y), box.t0, box.t1),
+                          hitArcBounds(reading, box.t0, box.t1), range_tolerance);
 }
 
 int boxConsensusBound(const MapRayCaster& map, const std::vector<Reading>& readings, double range_tolerance,
@@ -194,7 +204,13 @@ int boxConsensusBound(const MapRayCaster& map, const std::vector<Reading>& readi
 
 BoxConsensusTest::BoxConsensusTest(const MapRayCaster& map, const std::vector<Reading>& readings,
                                    double range_tolerance)
-  : map_(map), readings_(readings), range_tolerance_(range_tolerance), order_(readings.size())
+  : map_(map)
+  , readings_(readings)
+  , range_tolerance_(range_tolerance)
+  , order_(readings.size())
+  , sensor_arcs_(readings.size())
+  , hit_arcs_(readings.size())
+  , have_arcs_(readings.size(), 0)
 {
   std::iota(order_.begin(), order_.end(), std::size_t{ 0 });
 }
@@ -209,7 +225,9 @@ int BoxConsensusTest::bound(const PoseBox& box, int needed)
   const std::size_t k = order_.size();
   for (std::size_t i = 0; i < k && count + static_cast<long>(k - i) >= needed; ++i)
   {
-    if (readingMayExplain(map_, readings_[order_[i]], box, range_tolerance_))
+    const std::size_t r = order_[i];
+    ensureArcs(r, box);
+    if (mayExplainWithin(map_, readings_[r], box, sensor_arcs_[r], hit_arcs_[r], range_tolerance_))
     {
       ++count;
     }
@@ -222,6 +240,23 @@ int BoxConsensusTest::bound(const PoseBox& box, int needed)
     }
   }
   return count;
+}
+
+void BoxConsensusTest::ensureArcs(std::size_t r, const PoseBox& box)
+{
+  if (box.t0 != arcs_t0_ || box.t1 != arcs_t1_)
+  {
+    arcs_t0_ = box.t0;
+    arcs_t1_ = box.t1;
+    std::fill(have_arcs_.begin(), have_arcs_.end(), 0);
+  }
+  if (!have_arcs_[r])
+  {
+    const Pose2& g = readings_[r].offset;
+    sensor_arcs_[r] = rotatedArcBounds(Vec2(g.x, g.y), box.t0, box.t1);
+    hit_arcs_[r] = hitArcBounds(readings_[r], box.t0, box.t1);
+    have_arcs_[r] = 1;
+  }
 }
 
 AdaptiveSearchResult adaptiveSearch(const MapRayCaster& map, const std::vector<Reading>& readings,

@@ -20,6 +20,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -141,10 +142,21 @@ public:
   }
 
 private:
+  /// Reading @p r's arcs over @p box's headings, kept while the heading interval stays the same:
+  /// the boxes of one heading slice (a voxel grid's theta row) share them, and their
+  /// trigonometry was most of the test's time.
+  void ensureArcs(std::size_t r, const PoseBox& box);
+
   const MapRayCaster& map_;
   const std::vector<Reading>& readings_;
   double range_tolerance_;
   std::vector<std::size_t> order_;  ///< reading indices in the order they are tested
+  /// The heading interval [rad] the arcs below are for.
+  double arcs_t0_ = std::numeric_limits<double>::quiet_NaN();
+  double arcs_t1_ = std::numeric_limits<double>::quiet_NaN();
+  std::vector<Box2> sensor_arcs_;  ///< per reading: rotatedArcBounds() of its sensor's offset
+  std::vector<Box2> hit_arcs_;     ///< per reading: hitArcBounds()
+  std::vector<char> have_arcs_;    ///< per reading: the two arcs are for [arcs_t0_, arcs_t1_]
 };
 
 /// Exact bounding box of the arc R(theta) v for theta in [t0, t1] (t1 - t0 <= 2 pi).

@@ -88,9 +88,9 @@ TEST(ScreenLeaf, AnEmptyScreenProvesNoPoseOfTheLeafReachesTheCount)
 
 TEST(BoxConsensusTest, AnswersAsTheBoxBoundDoesWhileItReordersTheReadings)
 {
-  // One test over a leaf's sub-boxes (its reading order carried from box to box), against
-  // boxConsensusBound() on each: the same answer for every box and count,
-  // and some boxes pass and some fail.
+  // One test over a leaf's sub-boxes (its reading order carried from box to box, and its arcs
+  // while the heading half stays the same), against boxConsensusBound() on each: the same answer
+  // for every box and count, and some boxes pass and some fail.
   const auto map = test::loadMap("maps/apartment.poly");
   const double tau = 0.03;
   std::mt19937_64 rng(79);

@@ -249,6 +249,15 @@ const PastMiss kPastMisses[] = {
   { "TwoDirectionsAreLeftOutTogether", 2, 2, 865,
     "driving map 0 k 7 exact truth (-0.23483730570847072, 0.022629510449204471, "
     "-1.5512293191470186)" },
+  // Hunt 875: 3 finite readings and 12 no-returns. Four exact poses lie within 10 cm, the truth
+  // 9.6 cm from the one returned. The tied candidate's seed settled on an inexact place 25 cm
+  // away, and a region start reached that exact pose. The multi-start lattice went around the
+  // seed's place, not around the exact pose, so the truth was never polished to and the
+  // candidate's covariance did not cover it (the voxel engine). The lattice now goes around the
+  // best pose after the region starts (seed_refinement_starts.cpp, Refiner::multiStart()).
+  { "TheLatticeGoesAroundTheBestPoseFound", 2, 2, 875,
+    "no-return map 0 k 15 exact truth (0.054459552044487047, 0.31359115915498004, "
+    "0.77665308986350245) max range 1.2572851364844961" },
 };
 
 INSTANTIATE_TEST_SUITE_P(Lessons, PastMissesOnGeneratedMaps, ::testing::ValuesIn(kPastMisses),

@@ -144,7 +144,7 @@ public:
 private:
   /// Reading @p r's arcs over @p box's headings, kept while the heading interval stays the same:
   /// the boxes of one heading slice (a voxel grid's theta row) share them, and their
-  /// trigonometry was most of the test's time.
+  /// trigonometry was half of the test's time (AdaptiveSearch keeps its own per-level table).
   void ensureArcs(std::size_t r, const PoseBox& box);
 
   const MapRayCaster& map_;

@@ -4,8 +4,10 @@
 # checked against the truth and a sampled reference; prints the figures (docs/BENCHMARKS.md).
 #   VERIFY_TRIALS=N VERIFY_MINUTES=M   override the default 10,000 trials or 15 minutes
 #   VERIFY_MAPS="a.poly b.poly:0.25"   verify on these polygon maps (each scaled by :SCALE) ...
-#   VERIFY_RANDOM_MAPS=N VERIFY_BUILDINGS=N   ... and on N random 70-gons, N generated 12 x 9 m
-#                                      buildings drawn from the seed, instead of the small ones
+#   VERIFY_RANDOM_MAPS=N VERIFY_BUILDINGS=N VERIFY_ROOMS=N   ... and on N random 70-gons, N
+#                                      generated 12 x 9 m buildings, N furnished rooms (rotated
+#                                      boxes, round pillars, round halls) drawn from the seed,
+#                                      instead of the small ones
 #   VERIFY_SEED=S                      the trials' seed (default 16)
 #   VERIFY_RESOLUTION=N                the engines' resolution (default 64)
 #   VERIFY_K=MIN:MAX                   readings per trial (default 4:30; 4:6 hunts where few
@@ -22,6 +24,7 @@ for map in ${VERIFY_MAPS:-}; do
 done
 [ -z "${VERIFY_RANDOM_MAPS:-}" ] || map_args+=(--random-maps "$VERIFY_RANDOM_MAPS")
 [ -z "${VERIFY_BUILDINGS:-}" ] || map_args+=(--buildings "$VERIFY_BUILDINGS")
+[ -z "${VERIFY_ROOMS:-}" ] || map_args+=(--rooms "$VERIFY_ROOMS")
 [ -z "${VERIFY_K:-}" ] || map_args+=(--k "$VERIFY_K")
 [ -z "${VERIFY_FOV:-}" ] || map_args+=(--fov "$VERIFY_FOV")
 "$WS/devel/lib/fdml_localization/verify_localization" --trials "${VERIFY_TRIALS:-10000}" \

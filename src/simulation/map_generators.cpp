@@ -32,15 +32,7 @@ namespace fdml_localization
 {
 namespace core
 {
-namespace
-{
-namespace bg = boost::geometry;
-using BgPoint = bg::model::d2::point_xy<double>;
-using BgPolygon = bg::model::polygon<BgPoint>;
-using BgMulti = bg::model::multi_polygon<BgPolygon>;
-
-/// Throws std::invalid_argument naming the parameter and its allowed range.
-void require(bool ok, const std::string& name, double value, const std::string& range)
+void requireOption(bool ok, const std::string& name, double value, const std::string& range)
 {
   if (!ok)
   {
@@ -49,6 +41,13 @@ void require(bool ok, const std::string& name, double value, const std::string& 
     throw std::invalid_argument(msg.str());
   }
 }
+
+namespace
+{
+namespace bg = boost::geometry;
+using BgPoint = bg::model::d2::point_xy<double>;
+using BgPolygon = bg::model::polygon<BgPoint>;
+using BgMulti = bg::model::multi_polygon<BgPolygon>;
 
 /// Layout unit [m]: the building is laid out in whole units so that coordinates meant to be
 /// equal are computed from the same integers and are bit-identical.
@@ -166,10 +165,10 @@ std::vector<Units> splitLength(Units length, Units target, Units min_piece, std:
 
 PolygonMap randomPolygon(int vertices, double mean_radius, double radius_noise, std::uint64_t seed)
 {
-  require(vertices >= 3, "vertices", vertices, "an integer >= 3");
-  require(std::isfinite(mean_radius) && mean_radius > 0.0, "mean_radius", mean_radius, "(0, inf) m");
-  require(std::isfinite(radius_noise) && radius_noise >= 0.0 && radius_noise < 1.0, "radius_noise", radius_noise,
-          "[0, 1)");
+  requireOption(vertices >= 3, "vertices", vertices, "an integer >= 3");
+  requireOption(std::isfinite(mean_radius) && mean_radius > 0.0, "mean_radius", mean_radius, "(0, inf) m");
+  requireOption(std::isfinite(radius_noise) && radius_noise >= 0.0 && radius_noise < 1.0, "radius_noise", radius_noise,
+                "[0, 1)");
 
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -217,23 +216,24 @@ namespace
 {
 void validateBuildingOptions(const BuildingOptions& o)
 {
-  require(std::isfinite(o.wall_thickness) && o.wall_thickness >= 4.0 * kUnit && o.wall_thickness <= 1.0,
-          "wall_thickness", o.wall_thickness, "[0.0004, 1] m");
-  require(std::isfinite(o.door_width) && o.door_width >= 0.1 && o.door_width <= 100.0, "door_width", o.door_width,
-          "[0.1, 100] m");
-  require(std::isfinite(o.corridor_width) && o.corridor_width >= 2.0 * o.wall_thickness && o.corridor_width <= 100.0,
-          "corridor_width", o.corridor_width, "[2 * wall_thickness, 100] m");
+  requireOption(std::isfinite(o.wall_thickness) && o.wall_thickness >= 4.0 * kUnit && o.wall_thickness <= 1.0,
+                "wall_thickness", o.wall_thickness, "[0.0004, 1] m");
+  requireOption(std::isfinite(o.door_width) && o.door_width >= 0.1 && o.door_width <= 100.0, "door_width", o.door_width,
+                "[0.1, 100] m");
+  requireOption(std::isfinite(o.corridor_width) && o.corridor_width >= 2.0 * o.wall_thickness &&
+                    o.corridor_width <= 100.0,
+                "corridor_width", o.corridor_width, "[2 * wall_thickness, 100] m");
   // A room must hold a door a wall thickness away from each corner.
   const double min_room = std::max(o.door_width + 4.0 * o.wall_thickness, 1.0);
-  require(std::isfinite(o.room_size) && o.room_size >= min_room && o.room_size <= 1000.0, "room_size", o.room_size,
-          "[max(door_width + 4 * wall_thickness, 1), 1000] m");
+  requireOption(std::isfinite(o.room_size) && o.room_size >= min_room && o.room_size <= 1000.0, "room_size",
+                o.room_size, "[max(door_width + 4 * wall_thickness, 1), 1000] m");
   const double min_side = 2.0 * min_room + o.corridor_width;
-  require(std::isfinite(o.width) && o.width >= min_side && o.width <= 10000.0, "width", o.width,
-          "[2 * max(door_width + 4 * wall_thickness, 1) + corridor_width, 10000] m");
-  require(std::isfinite(o.height) && o.height >= min_side && o.height <= 10000.0, "height", o.height,
-          "[2 * max(door_width + 4 * wall_thickness, 1) + corridor_width, 10000] m");
-  require(o.pillar_probability >= 0.0 && o.pillar_probability <= 1.0, "pillar_probability", o.pillar_probability,
-          "[0, 1]");
+  requireOption(std::isfinite(o.width) && o.width >= min_side && o.width <= 10000.0, "width", o.width,
+                "[2 * max(door_width + 4 * wall_thickness, 1) + corridor_width, 10000] m");
+  requireOption(std::isfinite(o.height) && o.height >= min_side && o.height <= 10000.0, "height", o.height,
+                "[2 * max(door_width + 4 * wall_thickness, 1) + corridor_width, 10000] m");
+  requireOption(o.pillar_probability >= 0.0 && o.pillar_probability <= 1.0, "pillar_probability", o.pillar_probability,
+                "[0, 1]");
 }
 
 /// The building's plan in layout units, and the random draws that fill it.
@@ -282,7 +282,8 @@ void planBandsAndBlocks(BuildingPlan& p)
     --p.bands;
   }
   p.row_h = (p.height - p.bands * p.c) / (2 * p.bands);
-  require(p.row_h >= p.min_room_u, "height", o.height, "large enough for a row of rooms on each side of a corridor");
+  requireOption(p.row_h >= p.min_room_u, "height", o.height,
+                "large enough for a row of rooms on each side of a corridor");
   Units vcorr =
       std::max<Units>(1, static_cast<Units>(std::llround(o.width / (3.0 * o.room_size + o.corridor_width))) - 1);
   while (vcorr > 1 && (p.width - vcorr * p.c) / (vcorr + 1) < p.min_room_u)
@@ -290,9 +291,9 @@ void planBandsAndBlocks(BuildingPlan& p)
     --vcorr;
   }
   p.block_w = splitLength(p.width - vcorr * p.c, (p.width - vcorr * p.c) / (vcorr + 1), p.min_room_u, p.rng);
-  require(static_cast<Units>(p.block_w.size()) == vcorr + 1 &&
-              *std::min_element(p.block_w.begin(), p.block_w.end()) >= p.min_room_u,
-          "width", o.width, "large enough for a room on each side of a vertical corridor");
+  requireOption(static_cast<Units>(p.block_w.size()) == vcorr + 1 &&
+                    *std::min_element(p.block_w.begin(), p.block_w.end()) >= p.min_room_u,
+                "width", o.width, "large enough for a room on each side of a vertical corridor");
   Units x = 0;
   for (std::size_t b = 0; b < p.block_w.size(); ++b)
   {

@@ -8,11 +8,16 @@
 #include "fdml_localization/core/map/polygon_map.h"
 
 #include <cstdint>
+#include <string>
 
 namespace fdml_localization
 {
 namespace core
 {
+/// The generators' option check: throws std::invalid_argument "NAME = VALUE is out of range
+/// (allowed: RANGE)" unless @p ok.
+void requireOption(bool ok, const std::string& name, double value, const std::string& range);
+
 /**
  * @brief A random star-shaped simple polygon: @p vertices points at sorted random angles
  *        around the origin, at radius mean_radius * (1 + noise * u), u uniform in [-1, 1].

@@ -44,13 +44,14 @@ TEST_P(Verification, RandomTrialsNeverMissTheTruthNorContradictACertificate)
   expectNoFailure(verification::smallMaps(), GetParam(), 40, 1600);
 }
 
-// Maps no test was tuned on (generated_maps.h): a random 70-gon (walls at any angle) and a
+// Maps no test was tuned on (generated_maps.h): a random 70-gon (walls at any angle), a
 // generated 12 x 9 m building off the bundled maps' 5 cm raster (1.2 m corridors, 3 m rooms,
-// 80 cm doors); `verify_localization --random-maps N --buildings N` runs many more.
+// 80 cm doors) and a furnished 8 x 6 m room turned by a random angle (rotated boxes, round
+// pillars); `verify_localization --random-maps N --buildings N --rooms N` runs many more.
 TEST_P(Verification, GeneratedMapsNeverMissTheTruthNorContradictACertificate)
 {
   std::vector<std::shared_ptr<const MapRayCaster>> maps;
-  for (verification::GeneratedMap& generated : verification::generatedMaps(1, 1, 1601))
+  for (verification::GeneratedMap& generated : verification::generatedMaps(1, 1, 1601, 1))
   {
     maps.push_back(std::move(generated.map));
   }

@@ -3,14 +3,15 @@
 // per geometry and every failure; exits 1 when the truth was missed in a noise-free trial or a
 // certificate was contradicted.
 //   verify_localization [--trials N] [--minutes M] [--seed S] [--resolution N] [--map FILE.poly[:SCALE] ...]
-//                       [--random-maps N] [--buildings N] [--k MIN:MAX] [--fov DEG]
+//                       [--random-maps N] [--buildings N] [--rooms N] [--k MIN:MAX] [--fov DEG]
 // --map (repeatable) verifies on those polygon maps (scaled about the origin by SCALE), --random-maps
 // on N random star-shaped 70-gons (mean radius 2 m, radii 1 to 3 m), --buildings on N generated
-// 12 x 9 m buildings (1.2 m corridors, 3 m rooms, 10 cm walls), both drawn from the seed: maps no
-// test was tuned on. Without any of them, the three small built-in maps. --k draws the readings per
-// trial from [MIN, MAX] (default 4:30, within [3, 100]) to hunt where a search is hardest (few
-// readings); at the default the trials of a seed are those of earlier builds. --fov gives every
-// reading a cone of that full field of view [deg] (0 to 180): the same poses, cone ranges.
+// 12 x 9 m buildings (1.2 m corridors, 3 m rooms, 10 cm walls), --rooms on N furnished rooms (8 x 6 m
+// rooms and round halls 10 m across with 20 boxes and pillars, turned by any angle), all drawn
+// from the seed: maps no test was tuned on. Without any of them, the three small built-in maps. --k draws the readings
+// per trial from [MIN, MAX] (default 4:30, within [3, 100]) to hunt where a search is hardest (few readings); at the
+// default the trials of a seed are those of earlier builds. --fov gives every reading a cone of that full field of view
+// [deg] (0 to 180): the same poses, cone ranges.
 #include "generated_maps.h"
 #include "verification_checks.h"
 
@@ -40,6 +41,7 @@ struct Args
   std::vector<std::string> maps;  ///< FILE.poly[:SCALE]; none of these three: verification::smallMaps()
   int random_maps = 0;
   int buildings = 0;
+  int rooms = 0;
   verification::TrialSpec spec;  ///< --k, --fov
 };
 
@@ -144,6 +146,10 @@ bool parse(int argc, char** argv, Args& args)
     {
       args.buildings = static_cast<int>(value);
     }
+    else if (std::strcmp(argv[i], "--rooms") == 0 && value <= kMaxGenerated)
+    {
+      args.rooms = static_cast<int>(value);
+    }
     else
     {
       std::cerr << "verify_localization: unknown flag or value " << argv[i] << "\n";
@@ -194,7 +200,7 @@ bool loadMaps(const Args& args, std::vector<std::shared_ptr<const MapRayCaster>>
       names.push_back(spec);
     }
     for (verification::GeneratedMap& generated :
-         verification::generatedMaps(args.random_maps, args.buildings, args.seed))
+         verification::generatedMaps(args.random_maps, args.buildings, args.seed, args.rooms))
     {
       maps.push_back(std::move(generated.map));
       names.push_back(std::move(generated.name));
@@ -241,7 +247,8 @@ int main(int argc, char** argv)
   if (!parse(argc, argv, args))
   {
     std::cerr << "usage: verify_localization [--trials N] [--minutes M] [--seed S] [--resolution N] "
-                 "[--map FILE.poly[:SCALE] ...] [--random-maps N] [--buildings N] [--k MIN:MAX] [--fov DEG]\n";
+                 "[--map FILE.poly[:SCALE] ...] [--random-maps N] [--buildings N] [--rooms N] [--k MIN:MAX] "
+                 "[--fov DEG]\n";
     return 2;
   }
   std::vector<std::shared_ptr<const MapRayCaster>> maps;

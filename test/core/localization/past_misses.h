@@ -84,12 +84,12 @@ inline void expectTruthFound(const std::vector<std::shared_ptr<const MapRayCaste
 }
 
 /// expectTruthFound() for both engines at resolution 64 on the maps
-/// generatedMaps(@p random_maps, @p buildings, @p seed) draws (verify_localization's).
+/// generatedMaps(@p random_maps, @p buildings, @p seed, @p rooms) draws (verify_localization's).
 inline void expectTruthFoundOnGeneratedMaps(int random_maps, int buildings, std::uint64_t seed,
-                                            const std::string& label)
+                                            const std::string& label, int rooms = 0)
 {
   std::vector<std::shared_ptr<const MapRayCaster>> maps;
-  for (GeneratedMap& generated : generatedMaps(random_maps, buildings, seed))
+  for (GeneratedMap& generated : generatedMaps(random_maps, buildings, seed, rooms))
   {
     maps.push_back(std::move(generated.map));
   }

@@ -232,6 +232,25 @@ TEST(PastMissesOnBundledMaps, BothEnginesSearchEveryRegionReachingTheConsensus)
   }
 }
 
+// Thirtieth round: `verify_localization --seed 881` on bundled maps scaled (FAIL line of its map 6,
+// the warehouse scaled by 1.5, replayed as map 0). Four rays turning in place square to the walls
+// (34, 1.4, 38 and 2.5 m), the truth turned -1.85 deg from them: the heading mirrored about the
+// walls' normals, +1.85 deg, explains the readings exactly too, and the truth's basin is 0.035 rad
+// wide (the 38 m ray hits a shelf beyond it). The voxel engine returned only the twin, 3.7 deg away
+// within the uniqueness margins, its covariance not covering the truth (squared Mahalanobis
+// distance 113). Each tied candidate's mirrored headings are polished (mirroredTwins()).
+TEST(PastMissesOnScaledMaps, AHeadingMirroredAboutTheWallsIsFound)
+{
+  const std::vector<std::shared_ptr<const MapRayCaster>> maps{ std::make_shared<const MapRayCaster>(
+      loadPolyFile(std::string(FDML_SOURCE_DIR) + "/maps/warehouse.poly").scaled(1.5)) };
+  for (const Engine engine : { Engine::Voxel, Engine::Adaptive })
+  {
+    expectTruthFound(maps,
+                     "turning map 0 k 4 exact truth (37.8746098210177, 19.489786677102032, -0.032280911714278826)",
+                     engine, 64);
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Engines, PastMisses, ::testing::Values(Engine::Voxel, Engine::Adaptive),
                          [](const ::testing::TestParamInfo<Engine>& info) {
                            return std::string(toString(info.param));

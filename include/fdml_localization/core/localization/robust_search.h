@@ -271,12 +271,17 @@ Candidate polishedFrom(const MapRayCaster& map, const std::vector<Reading>& read
  *        piecewise-smooth cost has a basin per set of walls the rays hit, and the seeds'
  *        multi-start lattice is a cell wide: in the paper's floor plan scaled by 0.25, three rays
  *        hit a wall's jog 4 mm in front of the wall they hit from the truth, and the best candidate
- *        stopped 1.15 cm and 0.52 deg from it (RMS 4.2 mm against 0). An exact candidate near such
- *        an edge instead has its covariance widened to cover the exact places polished from a
- *        lattice four steps wide around it that tie it within the uniqueness margins
- *        (absorbTiedDuplicates()): two exact places 4.8 cm and 2.5 deg apart, or 3.1 deg apart
- *        where a cone's edge sweeps a wall, and the engine found the one the readings did not come
- *        from (verification seeds 815, 812). The candidates are ranked and de-duplicated again.
+ *        stopped 1.15 cm and 0.52 deg from it (RMS 4.2 mm against 0). An exact candidate instead
+ *        has its covariance widened to cover the exact places that tie it within the uniqueness
+ *        margins (absorbTiedDuplicates()), polished from a lattice four steps wide around it (near
+ *        such an edge) and from lattices at half and all of the margins; one beyond them is
+ *        another candidate: two exact places 4.8 cm and 2.5 deg apart, 3.1 deg apart where a
+ *        cone's edge sweeps a wall, 3.9 cm and 4.6 deg, and the engine found the one the readings
+ *        did not come from (verification seeds 815, 812, 883). Last, the heading mirrored about the walls where most
+ *        finite inlier rays meet theirs at one angle alpha to the normal (turned by -2 alpha) is
+ *        polished: a twin tying the candidate widens its covariance within the margins and is
+ *        another candidate beyond them (seed 881: rays square to a warehouse's walls read the same
+ *        at +-1.85 deg). The candidates are ranked and de-duplicated again.
  * @param options range_tolerance, the uniqueness margins, max_candidates and threads
  * @param settings the polish's eps, noise_sigma and max_iterations
  * @param candidates ranked (rankAndDeduplicate()), the best first

@@ -7,8 +7,8 @@
  */
 #pragma once
 
-#include "fdml_localization/core/geometry/ray_caster.h"
 #include "fdml_localization/core/geometry/geometry.h"
+#include "fdml_localization/core/geometry/ray_caster.h"
 #include "fdml_localization/simulation/furnished_room.h"
 #include "fdml_localization/simulation/map_generators.h"
 

@@ -277,11 +277,11 @@ Candidate polishedFrom(const MapRayCaster& map, const std::vector<Reading>& read
  *        such an edge) and from lattices at half and all of the margins; one beyond them is
  *        another candidate: two exact places 4.8 cm and 2.5 deg apart, 3.1 deg apart where a
  *        cone's edge sweeps a wall, 3.9 cm and 4.6 deg, and the engine found the one the readings
- *        did not come from (verification seeds 815, 812, 883). Last, the heading mirrored about the walls where most
- *        finite inlier rays meet theirs at one angle alpha to the normal (turned by -2 alpha) is
- *        polished: a twin tying the candidate widens its covariance within the margins and is
- *        another candidate beyond them (seed 881: rays square to a warehouse's walls read the same
- *        at +-1.85 deg). The candidates are ranked and de-duplicated again.
+ *        did not come from (verification seeds 815, 812, 883). Last, the heading mirrored about
+ *        the walls where most finite inlier rays meet theirs at one angle alpha to the normal
+ *        (turned by -2 alpha) is polished: a twin tying the candidate widens its covariance within
+ *        the margins and is another candidate beyond them (seed 881: rays square to a warehouse's
+ *        walls read the same at +-1.85 deg). The candidates are ranked and de-duplicated again.
  * @param options range_tolerance, the uniqueness margins, max_candidates and threads
  * @param settings the polish's eps, noise_sigma and max_iterations
  * @param candidates ranked (rankAndDeduplicate()), the best first

@@ -8,6 +8,7 @@
 #                                      generated 12 x 9 m buildings, N furnished rooms (rotated
 #                                      boxes, round pillars, round halls) drawn from the seed,
 #                                      instead of the small ones
+#   VERIFY_SCALE=S                     the generated maps scaled by S (0.05 to 20) about the origin
 #   VERIFY_SEED=S                      the trials' seed (default 16)
 #   VERIFY_RESOLUTION=N                the engines' resolution (default 64)
 #   VERIFY_K=MIN:MAX                   readings per trial (default 4:30; 4:6 hunts where few
@@ -25,6 +26,7 @@ done
 [ -z "${VERIFY_RANDOM_MAPS:-}" ] || map_args+=(--random-maps "$VERIFY_RANDOM_MAPS")
 [ -z "${VERIFY_BUILDINGS:-}" ] || map_args+=(--buildings "$VERIFY_BUILDINGS")
 [ -z "${VERIFY_ROOMS:-}" ] || map_args+=(--rooms "$VERIFY_ROOMS")
+[ -z "${VERIFY_SCALE:-}" ] || map_args+=(--scale "$VERIFY_SCALE")
 [ -z "${VERIFY_K:-}" ] || map_args+=(--k "$VERIFY_K")
 [ -z "${VERIFY_FOV:-}" ] || map_args+=(--fov "$VERIFY_FOV")
 "$WS/devel/lib/fdml_localization/verify_localization" --trials "${VERIFY_TRIALS:-10000}" \

@@ -68,39 +68,25 @@ double cross(const Vec2& u, const Vec2& v)
 }
 }  // namespace
 
-double raySegmentDistance(const Vec2& origin, const Vec2& dir, const Segment& seg)
+double rayParallelSegmentDistance(const Vec2& origin, const Vec2& dir, const Segment& seg)
 {
-  const Vec2 e = seg.b - seg.a;
+  // A hit only when collinear, then at the nearest point ahead of the origin.
   const Vec2 w = seg.a - origin;
-  const double denom = cross(dir, e);
-  // Parallel when |dir x e| <= 1e-14 |e| (compared squared: no square root on the hot path).
-  if (denom * denom <= 1e-28 * e.squaredNorm())
-  {
-    // Parallel: a hit only when collinear, then at the nearest point ahead of the origin.
-    if (std::abs(cross(w, dir)) > 1e-12 * std::max(1.0, w.norm()))
-    {
-      return kInf;
-    }
-    const double ta = w.dot(dir);
-    const double tb = (seg.b - origin).dot(dir);
-    if (ta < 0.0 && tb < 0.0)
-    {
-      return kInf;
-    }
-    if (ta <= 0.0 || tb <= 0.0)
-    {
-      return 0.0;  // the origin lies on the segment (possibly at an endpoint)
-    }
-    return std::min(ta, tb);
-  }
-  const double t = cross(w, e) / denom;    // along the ray
-  const double u = cross(w, dir) / denom;  // along the segment, in [0, 1] on it
-  const double tol = 1e-12;
-  if (t < -tol || u < -tol || u > 1.0 + tol)
+  if (std::abs(cross(w, dir)) > 1e-12 * std::max(1.0, w.norm()))
   {
     return kInf;
   }
-  return std::max(t, 0.0);
+  const double ta = w.dot(dir);
+  const double tb = (seg.b - origin).dot(dir);
+  if (ta < 0.0 && tb < 0.0)
+  {
+    return kInf;
+  }
+  if (ta <= 0.0 || tb <= 0.0)
+  {
+    return 0.0;  // the origin lies on the segment (possibly at an endpoint)
+  }
+  return std::min(ta, tb);
 }
 
 double rayCircleDistance(const Vec2& origin, const Vec2& dir, const Vec2& centre, double radius)

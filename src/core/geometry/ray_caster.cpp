@@ -1,6 +1,7 @@
 #include "fdml_localization/core/geometry/ray_caster.h"
 
 #include <algorithm>
+#include <atomic>
 
 namespace fdml_localization
 {
@@ -9,6 +10,22 @@ namespace core
 namespace
 {
 constexpr int kMaxCellsPerAxis = 4096;
+
+/// A thread's last MapRayCaster::isFree() verdict (map 0: none).
+struct FreeMemo
+{
+  std::uint64_t map = 0;
+  double x = 0.0;
+  double y = 0.0;
+  bool free = false;
+};
+
+/// A new MapRayCaster's id (from 1), unique in the process.
+std::uint64_t nextMapId()
+{
+  static std::atomic<std::uint64_t> next{ 1 };
+  return next.fetch_add(1, std::memory_order_relaxed);
+}
 }  // namespace
 
 SegmentGrid::SegmentGrid(std::vector<Segment> segments, double cell_size) : segments_(std::move(segments))
@@ -85,16 +102,6 @@ void SegmentGrid::buildCells()
   {
     forEachCellTouching(segments_[i], [&](std::size_t cell) { cell_items_[fill[cell]++] = static_cast<int>(i); });
   }
-}
-
-int SegmentGrid::cellX(double x) const
-{
-  return std::clamp(static_cast<int>(std::floor((x - bounds_.min.x()) / cell_)), 0, nx_ - 1);
-}
-
-int SegmentGrid::cellY(double y) const
-{
-  return std::clamp(static_cast<int>(std::floor((y - bounds_.min.y()) / cell_)), 0, ny_ - 1);
 }
 
 RayHit SegmentGrid::castBruteForce(const Vec2& origin, const Vec2& dir, double max_range) const
@@ -190,7 +197,11 @@ RayHit SegmentGrid::cast(const Vec2& origin, const Vec2& dir, double max_range) 
 
   while (true)
   {
-    castInCell(static_cast<std::size_t>(cy) * nx_ + cx, origin, dir, &best);
+    const std::size_t cell = static_cast<std::size_t>(cy) * nx_ + cx;
+    if (cell_start_[cell] != cell_start_[cell + 1])
+    {
+      castInCell(cell, origin, dir, &best);
+    }
     const double t_cell_exit = std::min(t_max_x, t_max_y);
     // Any hit in a later cell lies beyond this cell's exit. The tiny slack keeps ties (a hit
     // exactly on the border) resolved the same way as the brute-force loop.
@@ -306,7 +317,8 @@ int SegmentGrid::crossingsToRight(const Vec2& p) const
   return crossings;
 }
 
-MapRayCaster::MapRayCaster(PolygonMap map, double cell_size) : map_(std::move(map)), grid_(map_.edges(), cell_size)
+MapRayCaster::MapRayCaster(PolygonMap map, double cell_size)
+  : map_(std::move(map)), grid_(map_.edges(), cell_size), id_(nextMapId())
 {}
 
 double MapRayCaster::range(const Pose2& sensor, double max_range) const
@@ -320,7 +332,13 @@ bool MapRayCaster::isFree(const Vec2& p) const
   {
     return false;
   }
-  return grid_.oddCrossingsToRight(p);
+  // The thread's last verdict, for this map's contents and exactly this point.
+  thread_local FreeMemo memo;
+  if (memo.map != id_ || memo.x != p.x() || memo.y != p.y())
+  {
+    memo = FreeMemo{ id_, p.x(), p.y(), grid_.oddCrossingsToRight(p) };
+  }
+  return memo.free;
 }
 
 }  // namespace core

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
+#include <numeric>
 
 namespace fdml_localization
 {
@@ -203,42 +205,83 @@ std::vector<VoxelCluster> regionalMaxima(const GridSpec& spec, const std::vector
   return clusters;
 }
 
-std::vector<std::vector<std::size_t>> voxelsByCount(const std::vector<std::uint8_t>& count, int min_level,
-                                                    int max_level)
+namespace
 {
-  std::vector<std::vector<std::size_t>> buckets(static_cast<std::size_t>(std::max(max_level, 0)) + 1);
+/// Whether any of the 8 bytes of @p word is at least @p lo (1 <= lo <= 128): a byte above
+/// lo - 1 carries into its top bit (no carry crosses a byte below 128), and a byte of 128 or
+/// more already has it.
+bool anyByteAtLeast(std::uint64_t word, unsigned lo)
+{
+  constexpr std::uint64_t kOnes = 0x0101010101010101ull;
+  constexpr std::uint64_t kTops = 0x8080808080808080ull;
+  return (((word + kOnes * (128u - lo)) | word) & kTops) != 0;
+}
+
+/// Calls @p fn(v) for every voxel v (ascending) whose count lies in [lo, hi], lo >= 1.
+template <typename Fn>
+void forEachVoxelIn(const std::vector<std::uint8_t>& count, unsigned lo, unsigned hi, Fn&& fn)
+{
   const std::size_t n = count.size();
-  const std::uint8_t lo = static_cast<std::uint8_t>(std::max(min_level, 1));
   std::size_t v = 0;
-  // Skip 8 voxels at a time while none reaches the lowest level.
-  for (; v + 8 <= n; v += 8)
+  if (lo > 255u || lo > hi)
   {
-    const std::uint8_t* p = count.data() + v;
-    std::uint8_t m = 0;
-    for (int k = 0; k < 8; ++k)
+    return;
+  }
+  if (lo <= 128u)
+  {
+    // Skip 8 voxels at a time while none reaches lo.
+    for (; v + 8 <= n; v += 8)
     {
-      m = std::max(m, p[k]);
-    }
-    if (m < lo)
-    {
-      continue;
-    }
-    for (int k = 0; k < 8; ++k)
-    {
-      if (p[k] >= lo && p[k] <= max_level)
+      std::uint64_t word = 0;
+      std::memcpy(&word, count.data() + v, 8);
+      if (!anyByteAtLeast(word, lo))
       {
-        buckets[p[k]].push_back(v + k);
+        continue;
+      }
+      for (std::size_t j = v; j < v + 8; ++j)
+      {
+        if (count[j] >= lo && count[j] <= hi)
+        {
+          fn(j);
+        }
       }
     }
   }
   for (; v < n; ++v)
   {
-    if (count[v] >= lo && count[v] <= max_level)
+    if (count[v] >= lo && count[v] <= hi)
     {
-      buckets[count[v]].push_back(v);
+      fn(v);
     }
   }
+}
+}  // namespace
+
+std::vector<std::vector<std::size_t>> voxelsByCount(const std::vector<std::uint8_t>& count, int min_level,
+                                                    int max_level)
+{
+  std::vector<std::vector<std::size_t>> buckets(static_cast<std::size_t>(std::max(max_level, 0)) + 1);
+  if (max_level < 1)
+  {
+    return buckets;
+  }
+  const auto lo = static_cast<unsigned>(std::clamp(min_level, 1, 256));
+  forEachVoxelIn(count, lo, static_cast<unsigned>(std::min(max_level, 255)),
+                 [&](std::size_t v) { buckets[count[v]].push_back(v); });
   return buckets;
+}
+
+std::vector<std::size_t> voxelsAtLeast(const std::vector<std::uint8_t>& count, int level)
+{
+  std::vector<std::size_t> voxels;
+  if (level <= 0)
+  {
+    voxels.resize(count.size());
+    std::iota(voxels.begin(), voxels.end(), std::size_t{ 0 });
+    return voxels;
+  }
+  forEachVoxelIn(count, static_cast<unsigned>(std::min(level, 256)), 255u, [&](std::size_t v) { voxels.push_back(v); });
+  return voxels;
 }
 
 }  // namespace core

@@ -90,8 +90,17 @@ std::vector<double> vertexMargins(const MapRayCaster& map, const Pose2& pose, co
   return margins;
 }
 
-PoseEvaluation evaluatePose(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings,
-                            double eps)
+std::vector<double> poseResiduals(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings)
+{
+  std::vector<double> residuals(readings.size());
+  for (std::size_t i = 0; i < readings.size(); ++i)
+  {
+    residuals[i] = readingResidual(map, pose, readings[i]);
+  }
+  return residuals;
+}
+
+PoseEvaluation evaluateResiduals(const std::vector<double>& residuals, const std::vector<Reading>& readings, double eps)
 {
   PoseEvaluation eval;
   eval.inlier_mask.assign(readings.size(), false);
@@ -100,7 +109,7 @@ PoseEvaluation evaluatePose(const MapRayCaster& map, const Pose2& pose, const st
   int finite_inliers = 0;
   for (std::size_t i = 0; i < readings.size(); ++i)
   {
-    const double r = readingResidual(map, pose, readings[i]);
+    const double r = residuals[i];
     if (std::isnan(r))
     {
       continue;
@@ -121,6 +130,12 @@ PoseEvaluation evaluatePose(const MapRayCaster& map, const Pose2& pose, const st
   }
   eval.rms = finite_inliers > 0 ? std::sqrt(sum_sq / finite_inliers) : 0.0;
   return eval;
+}
+
+PoseEvaluation evaluatePose(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings,
+                            double eps)
+{
+  return evaluateResiduals(poseResiduals(map, pose, readings), readings, eps);
 }
 
 Candidate verifiedCandidate(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings,

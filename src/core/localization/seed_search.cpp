@@ -58,8 +58,10 @@ public:
     for (long c = first; c < n; ++c)
     {
       const Pose2& start = seeds_[c].start;
-      candidates_[c] = verifiedCandidate(ctx_.map, start, ctx_.readings, ctx_.settings.agreement_tolerance);
-      rough_[c] = evaluatePose(ctx_.map, start, ctx_.readings, ctx_.loose_gate).inliers;
+      const std::vector<double> residuals = poseResiduals(ctx_.map, start, ctx_.readings);
+      candidates_[c] =
+          candidateFrom(start, evaluateResiduals(residuals, ctx_.readings, ctx_.settings.agreement_tolerance));
+      rough_[c] = evaluateResiduals(residuals, ctx_.readings, ctx_.loose_gate).inliers;
       // Near a depth discontinuity (a ray grazing a corner) a few centimetres change a range
       // by metres: the region's other poses may agree where its centre does not. Start where
       // the most readings roughly agree.

@@ -129,6 +129,53 @@ std::set<std::size_t> undominatedVoxels(const GridSpec& spec, const std::vector<
   return expected;
 }
 
+// The buckets skip eight voxels at a time (a word test of its bytes): against a plain scan, at
+// every level, on fields of every byte value and of runs reaching a level in one byte only.
+TEST(Components, VoxelBucketsMatchAPlainScan)
+{
+  std::mt19937 rng(11);
+  std::vector<std::uint8_t> count(1003, 0);
+  for (int round = 0; round < 4; ++round)
+  {
+    for (std::size_t v = 0; v < count.size(); ++v)
+    {
+      // Round 0: any byte; then mostly zeros, a rare byte of any value (one byte of a word reaching a level).
+      const unsigned value = rng() % 256u;
+      count[v] = static_cast<std::uint8_t>(round == 0 || rng() % 16u == 0 ? value : 0u);
+    }
+    for (int level = -1; level <= 256; ++level)
+    {
+      std::vector<std::size_t> at_least;
+      for (std::size_t v = 0; v < count.size(); ++v)
+      {
+        if (static_cast<int>(count[v]) >= level)
+        {
+          at_least.push_back(v);
+        }
+      }
+      ASSERT_EQ(voxelsAtLeast(count, level), at_least) << "level " << level;
+    }
+    for (int lo : { 1, 2, 7, 127, 128, 129, 200, 255 })
+    {
+      const int hi = std::min(255, lo + 40);
+      const auto buckets = voxelsByCount(count, lo, hi);
+      ASSERT_EQ(buckets.size(), static_cast<std::size_t>(hi) + 1);
+      for (int c = 0; c <= hi; ++c)
+      {
+        std::vector<std::size_t> expected;
+        for (std::size_t v = 0; v < count.size() && c >= lo; ++v)
+        {
+          if (count[v] == c)
+          {
+            expected.push_back(v);
+          }
+        }
+        ASSERT_EQ(buckets[c], expected) << "lo " << lo << " count " << c;
+      }
+    }
+  }
+}
+
 TEST(HypothesisSeeds, MaximalSetsMatchBruteForce)
 {
   // Random blobs of 6 readings on a small periodic grid; the kept voxels must be exactly those

@@ -3,15 +3,16 @@
 // per geometry and every failure; exits 1 when the truth was missed in a noise-free trial or a
 // certificate was contradicted.
 //   verify_localization [--trials N] [--minutes M] [--seed S] [--resolution N] [--map FILE.poly[:SCALE] ...]
-//                       [--random-maps N] [--buildings N] [--rooms N] [--k MIN:MAX] [--fov DEG]
+//                       [--random-maps N] [--buildings N] [--rooms N] [--scale S] [--k MIN:MAX] [--fov DEG]
 // --map (repeatable) verifies on those polygon maps (scaled about the origin by SCALE), --random-maps
 // on N random star-shaped 70-gons (mean radius 2 m, radii 1 to 3 m), --buildings on N generated
 // 12 x 9 m buildings (1.2 m corridors, 3 m rooms, 10 cm walls), --rooms on N furnished rooms (8 x 6 m
 // rooms and round halls 10 m across with 20 boxes and pillars, turned by any angle), all drawn
-// from the seed: maps no test was tuned on. Without any of them, the three small built-in maps. --k draws the readings
-// per trial from [MIN, MAX] (default 4:30, within [3, 100]) to hunt where a search is hardest (few readings); at the
-// default the trials of a seed are those of earlier builds. --fov gives every reading a cone of that full field of view
-// [deg] (0 to 180): the same poses, cone ranges.
+// from the seed: maps no test was tuned on; --scale S (0.05 to 20) scales the generated ones about
+// the origin. Without any of them, the three small built-in maps. --k draws the readings per trial
+// from [MIN, MAX] (default 4:30, within [3, 100]) to hunt where a search is hardest (few readings);
+// at the default the trials of a seed are those of earlier builds. --fov gives every reading a cone
+// of that full field of view [deg] (0 to 180): the same poses, cone ranges.
 #include "generated_maps.h"
 #include "verification_checks.h"
 
@@ -19,6 +20,7 @@
 #include "fdml_localization/core/util/text_parsing.h"
 
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
@@ -42,6 +44,7 @@ struct Args
   int random_maps = 0;
   int buildings = 0;
   int rooms = 0;
+  double scale = 1.0;            ///< the generated maps scaled about the origin
   verification::TrialSpec spec;  ///< --k, --fov
 };
 
@@ -95,8 +98,54 @@ bool parseTrialFlag(const char* flag, const std::string& value, verification::Tr
   return true;
 }
 
-/// Generated maps beside the files: at most this many of each kind.
+/// Generated maps beside the files: at most this many of each kind ...
 constexpr double kMaxGenerated = 100;
+/// ... scaled by a factor in this range (--scale).
+constexpr double kMinScale = 0.05;
+constexpr double kMaxScale = 20.0;
+
+/// Sets the numeric flag @p flag to @p value (positive, at most 1e9); false for an unknown flag
+/// or a value outside the flag's range.
+bool setNumericFlag(const char* flag, double value, Args& args)
+{
+  if (std::strcmp(flag, "--trials") == 0)
+  {
+    args.trials = static_cast<long>(value);
+  }
+  else if (std::strcmp(flag, "--minutes") == 0)
+  {
+    args.minutes = value;
+  }
+  else if (std::strcmp(flag, "--seed") == 0)
+  {
+    args.seed = static_cast<unsigned long>(value);
+  }
+  else if (std::strcmp(flag, "--resolution") == 0 && value >= 16 && value <= 1024)
+  {
+    args.resolution = static_cast<int>(value);
+  }
+  else if (std::strcmp(flag, "--random-maps") == 0 && value <= kMaxGenerated)
+  {
+    args.random_maps = static_cast<int>(value);
+  }
+  else if (std::strcmp(flag, "--buildings") == 0 && value <= kMaxGenerated)
+  {
+    args.buildings = static_cast<int>(value);
+  }
+  else if (std::strcmp(flag, "--rooms") == 0 && value <= kMaxGenerated)
+  {
+    args.rooms = static_cast<int>(value);
+  }
+  else if (std::strcmp(flag, "--scale") == 0 && value >= kMinScale && value <= kMaxScale)
+  {
+    args.scale = value;
+  }
+  else
+  {
+    return false;
+  }
+  return true;
+}
 
 bool parse(int argc, char** argv, Args& args)
 {
@@ -122,35 +171,7 @@ bool parse(int argc, char** argv, Args& args)
       std::cerr << "verify_localization: " << argv[i] << " needs a positive number, got '" << argv[i + 1] << "'\n";
       return false;
     }
-    if (std::strcmp(argv[i], "--trials") == 0)
-    {
-      args.trials = static_cast<long>(value);
-    }
-    else if (std::strcmp(argv[i], "--minutes") == 0)
-    {
-      args.minutes = value;
-    }
-    else if (std::strcmp(argv[i], "--seed") == 0)
-    {
-      args.seed = static_cast<unsigned long>(value);
-    }
-    else if (std::strcmp(argv[i], "--resolution") == 0 && value >= 16 && value <= 1024)
-    {
-      args.resolution = static_cast<int>(value);
-    }
-    else if (std::strcmp(argv[i], "--random-maps") == 0 && value <= kMaxGenerated)
-    {
-      args.random_maps = static_cast<int>(value);
-    }
-    else if (std::strcmp(argv[i], "--buildings") == 0 && value <= kMaxGenerated)
-    {
-      args.buildings = static_cast<int>(value);
-    }
-    else if (std::strcmp(argv[i], "--rooms") == 0 && value <= kMaxGenerated)
-    {
-      args.rooms = static_cast<int>(value);
-    }
-    else
+    if (!setNumericFlag(argv[i], value, args))
     {
       std::cerr << "verify_localization: unknown flag or value " << argv[i] << "\n";
       return false;
@@ -202,8 +223,16 @@ bool loadMaps(const Args& args, std::vector<std::shared_ptr<const MapRayCaster>>
     for (verification::GeneratedMap& generated :
          verification::generatedMaps(args.random_maps, args.buildings, args.seed, args.rooms))
     {
-      maps.push_back(std::move(generated.map));
-      names.push_back(std::move(generated.name));
+      if (args.scale == 1.0)
+      {
+        maps.push_back(std::move(generated.map));
+        names.push_back(std::move(generated.name));
+        continue;
+      }
+      maps.push_back(std::make_shared<const MapRayCaster>(generated.map->map().scaled(args.scale)));
+      char factor[32];
+      std::snprintf(factor, sizeof(factor), " x %g", args.scale);
+      names.push_back(generated.name + factor);
     }
   }
   catch (const std::exception& e)
@@ -247,8 +276,8 @@ int main(int argc, char** argv)
   if (!parse(argc, argv, args))
   {
     std::cerr << "usage: verify_localization [--trials N] [--minutes M] [--seed S] [--resolution N] "
-                 "[--map FILE.poly[:SCALE] ...] [--random-maps N] [--buildings N] [--rooms N] [--k MIN:MAX] "
-                 "[--fov DEG]\n";
+                 "[--map FILE.poly[:SCALE] ...] [--random-maps N] [--buildings N] [--rooms N] [--scale S] "
+                 "[--k MIN:MAX] [--fov DEG]\n";
     return 2;
   }
   std::vector<std::shared_ptr<const MapRayCaster>> maps;

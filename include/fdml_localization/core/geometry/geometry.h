@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -111,6 +112,9 @@ struct Box2
   }
 };
 
+/// raySegmentDistance() for a ray parallel to the segment (|dir x e| <= 1e-14 |e|, e = b - a).
+double rayParallelSegmentDistance(const Vec2& origin, const Vec2& dir, const Segment& seg);
+
 /**
  * @brief Distance along a ray to a segment.
  * @param origin ray origin [m]
@@ -119,7 +123,26 @@ struct Box2
  * @return the smallest t >= 0 with origin + t dir on the segment [m], or +inf when the ray
  *         misses it. A ray collinear with the segment hits it at its nearest point.
  */
-double raySegmentDistance(const Vec2& origin, const Vec2& dir, const Segment& seg);
+inline double raySegmentDistance(const Vec2& origin, const Vec2& dir, const Segment& seg)
+{
+  // Inline: the innermost loop of every ray cast.
+  const Vec2 e = seg.b - seg.a;
+  const Vec2 w = seg.a - origin;
+  const double denom = dir.x() * e.y() - dir.y() * e.x();
+  // Parallel when |dir x e| <= 1e-14 |e| (compared squared: no square root on the hot path).
+  if (denom * denom <= 1e-28 * e.squaredNorm())
+  {
+    return rayParallelSegmentDistance(origin, dir, seg);
+  }
+  const double t = (w.x() * e.y() - w.y() * e.x()) / denom;      // along the ray
+  const double u = (w.x() * dir.y() - w.y() * dir.x()) / denom;  // along the segment, in [0, 1] on it
+  const double tol = 1e-12;
+  if (t < -tol || u < -tol || u > 1.0 + tol)
+  {
+    return kInf;
+  }
+  return std::max(t, 0.0);
+}
 
 /// Distance along a ray to a circle's boundary [m] (+inf on a miss; 0 when the origin is inside).
 double rayCircleDistance(const Vec2& origin, const Vec2& dir, const Vec2& centre, double radius);

@@ -122,8 +122,24 @@ private:
   /// Ray parameter at which origin + t dir leaves cell column/row @p c through its border on
   /// the @p step side along @p axis (+inf when dir is parallel to that border).
   double nextBorder(const Vec2& origin, const Vec2& dir, int axis, int c, int step) const;
-  int cellX(double x) const;
-  int cellY(double y) const;
+  /// The column / row holding @p x / @p y, clamped to the grid (0 for NaN).
+  int cellX(double x) const
+  {
+    return cellIndex((x - bounds_.min.x()) / cell_, nx_);
+  }
+  int cellY(double y) const
+  {
+    return cellIndex((y - bounds_.min.y()) / cell_, ny_);
+  }
+  /// floor(@p v) clamped to [0, n - 1] (n >= 1) without a call to floor (the casts' hot path).
+  static int cellIndex(double v, int n)
+  {
+    if (!(v >= 0.0))
+    {
+      return 0;
+    }
+    return v >= n ? n - 1 : static_cast<int>(v);
+  }
 
   std::vector<Segment> segments_;
   Box2 bounds_;
@@ -153,7 +169,9 @@ public:
     return grid_.cast(origin, dir, max_range);
   }
 
-  /// True when p is inside the outer ring and outside every hole.
+  /// True when p is inside the outer ring and outside every hole. Each thread remembers its last
+  /// point and verdict: the readings of one pose often share a sensor position (a rotating
+  /// rangefinder), and their checks follow one another.
   bool isFree(const Vec2& p) const;
 
   const PolygonMap& map() const
@@ -168,6 +186,8 @@ public:
 private:
   PolygonMap map_;
   SegmentGrid grid_;
+  /// Names this map's contents for isFree()'s memo (copies share it, as they share the contents).
+  std::uint64_t id_ = 0;
 };
 
 }  // namespace core

@@ -82,9 +82,13 @@ std::vector<std::size_t> componentSizes(const GridSpec& spec, const std::vector<
 std::vector<VoxelCluster> regionalMaxima(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
                                          const std::vector<std::size_t>& candidates);
 
-/// The voxels of each count value: result[c] lists the voxels with count c, for c >= min_level.
+/// The voxels of each count value: result[c] lists the voxels (ascending) with count c, for
+/// max(min_level, 1) <= c <= max_level.
 std::vector<std::vector<std::size_t>> voxelsByCount(const std::vector<std::uint8_t>& count, int min_level,
                                                     int max_level);
+
+/// The voxels (ascending) whose count reaches @p level (all of them when @p level <= 0).
+std::vector<std::size_t> voxelsAtLeast(const std::vector<std::uint8_t>& count, int level);
 
 }  // namespace core
 }  // namespace fdml_localization

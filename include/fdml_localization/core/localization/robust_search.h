@@ -61,6 +61,14 @@ double readingResidual(const MapRayCaster& map, const Pose2& pose, const Reading
 double residualSignChange(const MapRayCaster& map, const Pose2& pose, const Reading& reading,
                           const Eigen::Vector3d& direction, double a, double b, double r_a, double r_b);
 
+/// Every reading's readingResidual() at @p pose [m] (NaN where its sensor lies outside free space).
+std::vector<double> poseResiduals(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings);
+
+/// evaluatePose() from the readings' residuals (poseResiduals()) at one pose: one cast per
+/// reading serves several tolerances @p eps [m].
+PoseEvaluation evaluateResiduals(const std::vector<double>& residuals, const std::vector<Reading>& readings,
+                                 double eps);
+
 /**
  * @brief Verifies @p pose: reading i agrees when its sensor position q (+) g_i is in free
  *        space and |h(q (+) g_i) - d_i| < eps (h: predictedRange(), the cone cast for a cone

@@ -342,25 +342,17 @@ PoseBox voxelBox(const GridSpec& spec, std::size_t v)
   return box;
 }
 
-std::vector<LeafBox> voxelLeaves(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level)
+LeafBox voxelLeaf(const GridSpec& spec, std::size_t v, int count)
 {
-  std::vector<LeafBox> leaves;
-  for (std::size_t v = 0; v < count.size(); ++v)
-  {
-    if (count[v] >= level)
-    {
-      LeafBox leaf;
-      leaf.box = voxelBox(spec, v);
-      leaf.count = count[v];
-      int ix = 0, iy = 0, it = 0;
-      spec.unindex(v, ix, iy, it);
-      leaf.ix = ix;
-      leaf.iy = iy;
-      leaf.it = it;
-      leaves.push_back(leaf);
-    }
-  }
-  return leaves;
+  LeafBox leaf;
+  leaf.box = voxelBox(spec, v);
+  leaf.count = count;
+  int ix = 0, iy = 0, it = 0;
+  spec.unindex(v, ix, iy, it);
+  leaf.ix = ix;
+  leaf.iy = iy;
+  leaf.it = it;
+  return leaf;
 }
 
 }  // namespace core

@@ -35,6 +35,45 @@ constexpr std::size_t kSampledVoxels = 512;
 /// ... which gives three distinct seeds from this many voxels on (smaller ones one).
 constexpr std::size_t kLargePlateau = 16;
 
+/// The voxels of a count field by count (voxelsByCount()), bucketed when a level is first asked
+/// for: the search's first levels in one pass over the field, the lower ones (holding most
+/// voxels, and rarely reached) in a second.
+class CountBuckets
+{
+public:
+  CountBuckets(const std::vector<std::uint8_t>& count, int lowest, int k)
+    : count_(count), lowest_(lowest), k_(k), built_from_(k + 1), buckets_(static_cast<std::size_t>(k) + 1)
+  {}
+
+  /// The voxels (ascending) whose count is @p level; none below the lowest level.
+  const std::vector<std::size_t>& at(int level)
+  {
+    if (level < lowest_ || level > k_)
+    {
+      return none_;
+    }
+    if (level < built_from_)
+    {
+      const int from = built_from_ > k_ ? std::max(lowest_, level - 2) : lowest_;
+      std::vector<std::vector<std::size_t>> more = voxelsByCount(count_, from, built_from_ - 1);
+      for (int l = from; l < built_from_; ++l)
+      {
+        buckets_[l] = std::move(more[l]);
+      }
+      built_from_ = from;
+    }
+    return buckets_[level];
+  }
+
+private:
+  const std::vector<std::uint8_t>& count_;
+  int lowest_;
+  int k_;
+  int built_from_;  ///< the levels from here to k_ are bucketed
+  std::vector<std::vector<std::size_t>> buckets_;
+  const std::vector<std::size_t> none_;
+};
+
 /// The voxel engine's seeds, level by level: every locally maximal set of readings of the
 /// seeding's sample preimages (hypothesis_seeds.h) and, because that test can miss the truth's
 /// voxel next to a discontinuity of h, the count peaks of their dilation.
@@ -43,14 +82,15 @@ class VoxelSeeds : public SeedSource
 public:
   VoxelSeeds(const VoxelEngine& engine, const MapRayCaster& map, const std::vector<Reading>& readings, double gate,
              int lowest, int k, StageTimes& times)
-    : engine_(engine), map_(map), readings_(readings), gate_(gate), times_(times)
-  {
-    const auto stage = std::chrono::steady_clock::now();
-    buckets_ = voxelsByCount(engine.lastSeedCount(), lowest, k);
-    raw_buckets_ = voxelsByCount(engine.lastRawCount(), lowest, k);
-    conservative_buckets_ = voxelsByCount(engine.lastCount(), lowest, k);
-    times_.components += secondsSince(stage);
-  }
+    : engine_(engine)
+    , map_(map)
+    , readings_(readings)
+    , gate_(gate)
+    , times_(times)
+    , conservative_buckets_(engine.lastCount(), lowest, k)
+    , buckets_(engine.lastSeedCount(), lowest, k)
+    , raw_buckets_(engine.lastRawCount(), lowest, k)
+  {}
 
   std::vector<SearchSeed> seedsAt(int level) override
   {
@@ -58,11 +98,11 @@ public:
     const GridSpec& spec = engine_.grid();
     std::vector<SearchSeed> seeds;
     for (HypothesisSeed& h : maximalHypotheses(spec, engine_.lastRawPreimages(), engine_.lastRawCount(), level,
-                                               raw_buckets_[level], engine_.threads()))
+                                               raw_buckets_.at(level), engine_.threads()))
     {
       seeds.push_back(seedOf(h.plateau, std::move(h.hypothesis)));
     }
-    for (VoxelCluster& c : regionalMaxima(spec, engine_.lastSeedCount(), level, buckets_[level]))
+    for (VoxelCluster& c : regionalMaxima(spec, engine_.lastSeedCount(), level, buckets_.at(level)))
     {
       seeds.push_back(seedOf(c, engine_.membership(c.representative, engine_.lastSeedPreimages())));
     }
@@ -75,11 +115,11 @@ private:
   /// The sample tests can miss the truth's voxel next to a discontinuity of h; the conservative
   /// count field never does: each of its regional maxima also gives the voxels (of some spread
   /// over it) agreeing best with the readings.
-  void addConservativeSeeds(int level, std::vector<SearchSeed>& seeds) const
+  void addConservativeSeeds(int level, std::vector<SearchSeed>& seeds)
   {
     const GridSpec& spec = engine_.grid();
     const std::vector<VoxelCluster> maxima =
-        regionalMaxima(spec, engine_.lastCount(), level, conservative_buckets_[level]);
+        regionalMaxima(spec, engine_.lastCount(), level, conservative_buckets_.at(level));
     std::vector<std::vector<Pose2>> starts(maxima.size());
 #pragma omp parallel for schedule(dynamic, 4) num_threads(engine_.threads()) if (maxima.size() >= 8)
     for (long m = 0; m < static_cast<long>(maxima.size()); ++m)
@@ -147,9 +187,9 @@ private:
   const std::vector<Reading>& readings_;
   double gate_;
   StageTimes& times_;
-  std::vector<std::vector<std::size_t>> conservative_buckets_;
-  std::vector<std::vector<std::size_t>> buckets_;
-  std::vector<std::vector<std::size_t>> raw_buckets_;
+  CountBuckets conservative_buckets_;
+  CountBuckets buckets_;
+  CountBuckets raw_buckets_;
 };
 }  // namespace
 
@@ -205,22 +245,29 @@ void VoxelEngine::localizeRobust(const std::vector<Reading>& readings, Result& r
   if (!result.candidates.empty())
   {
     const int target = netConsensus(result.candidates.front());
-    std::vector<LeafBox> leaves = voxelLeaves(spec_, count_, target);
     // The box test bounds a voxel's consensus tighter than the count's distance bounds (and it
     // stops early where the target is out of reach). One test per thread: neighbouring voxels are
-    // mostly ruled out by the same reading (BoxConsensusTest).
-#pragma omp parallel num_threads(threads()) if (leaves.size() >= 1024)
+    // mostly ruled out by the same reading (BoxConsensusTest). Only the voxels passing become leaves.
+    const std::vector<std::size_t> reaching = voxelsAtLeast(count_, target);
+    std::vector<int> bounds(reaching.size(), 0);
+#pragma omp parallel num_threads(threads()) if (reaching.size() >= 1024)
     {
       BoxConsensusTest test(*map_, readings, options_.range_tolerance);
 #pragma omp for schedule(dynamic, 256)
-      for (long l = 0; l < static_cast<long>(leaves.size()); ++l)
+      for (long j = 0; j < static_cast<long>(reaching.size()); ++j)
       {
-        LeafBox& leaf = leaves[static_cast<std::size_t>(l)];
-        leaf.count = std::min(leaf.count, test.bound(leaf.box, target));
+        const std::size_t v = reaching[static_cast<std::size_t>(j)];
+        bounds[j] = std::min<int>(count_[v], test.bound(voxelBox(spec_, v), target));
       }
     }
-    leaves.erase(std::remove_if(leaves.begin(), leaves.end(), [&](const LeafBox& l) { return l.count < target; }),
-                 leaves.end());
+    std::vector<LeafBox> leaves;
+    for (std::size_t j = 0; j < reaching.size(); ++j)
+    {
+      if (bounds[j] >= target)
+      {
+        leaves.push_back(voxelLeaf(spec_, reaching[j], bounds[j]));
+      }
+    }
     const RefinementSettings settings = latticeRefinement(options_, spec_.cell, spec_.thetaStep());
     fillUncoveredRegions(*map_, leaves, spec_.nt, readings, options_, settings, result);
     settleInNearBasins(*map_, readings, options_, settings, result.candidates);

@@ -65,11 +65,11 @@ std::vector<std::size_t> leavesToSearch(const std::vector<LeafBox>& leaves, cons
 PoseBox voxelBox(const GridSpec& spec, std::size_t v);
 
 /**
- * @brief The voxels whose @p count reaches @p level as leaves (voxelBox(), the count, the voxel's
+ * @brief Voxel @p v of @p spec as a leaf holding @p count readings (voxelBox(), the voxel's
  *        indices as the leaf's cell): the voxel engine's cells searched as the adaptive engine's
  *        leaves are (region_fill.h). Heading cells: spec.nt.
  */
-std::vector<LeafBox> voxelLeaves(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level);
+LeafBox voxelLeaf(const GridSpec& spec, std::size_t v, int count);
 
 }  // namespace core
 }  // namespace fdml_localization

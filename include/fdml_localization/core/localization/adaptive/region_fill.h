@@ -1,7 +1,7 @@
 /**
  * @file region_fill.h
  * @brief Both engines' last look at the places their seeds missed (issue 16): the leaves (the
- *        voxel engine's voxels as leaves, voxelLeaves()) reaching the best candidate's consensus
+ *        voxel engine's voxels as leaves, voxelLeaf()) reaching the best candidate's consensus
  *        that hold no candidate are searched through their sub-boxes (pruned by the box bound),
  *        the best verified pose refined; a pose explaining as many readings as the best candidate
  *        (or more) joins the candidates. Where the readings leave a continuum (few finite ranges,

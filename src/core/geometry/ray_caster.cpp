@@ -175,13 +175,15 @@ double SegmentGrid::nextBorder(const Vec2& origin, const Vec2& dir, int axis, in
 RayHit SegmentGrid::cast(const Vec2& origin, const Vec2& dir, double max_range) const
 {
   RayHit best;
-  if (segments_.empty())
+  if (segments_.empty() || !(max_range >= 0.0))
   {
     return best;
   }
   double t_enter = 0.0;
   double t_exit = max_range;
-  if (!clipToBounds(origin, dir, &t_enter, &t_exit))
+  // From inside the grid's box the walk starts at the origin and needs no exit: every segment lies
+  // inside the box, so the cells beyond it (if any) hold no hit nearer than one inside it.
+  if (!bounds_.contains(origin) && !clipToBounds(origin, dir, &t_enter, &t_exit))
   {
     return best;
   }

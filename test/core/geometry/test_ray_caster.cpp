@@ -339,6 +339,30 @@ TEST(RayCaster, IsFreeEqualsBruteForce)
   }
 }
 
+// isFree() remembers a thread's last point and verdict: the same point asked of two maps in turn,
+// of a copy, and of a map assigned over another gets each map's own answer.
+TEST(RayCaster, IsFreeOfOnePointOnSeveralMaps)
+{
+  const Ring outer{ Vec2(0.0, 0.0), Vec2(10.0, 0.0), Vec2(10.0, 10.0), Vec2(0.0, 10.0) };
+  const Ring pillar{ Vec2(4.0, 4.0), Vec2(4.0, 6.0), Vec2(6.0, 6.0), Vec2(6.0, 4.0) };
+  const MapRayCaster open(PolygonMap::fromRings({ outer }));
+  const MapRayCaster pillared(PolygonMap::fromRings({ outer, pillar }));  // same bounds
+  const MapRayCaster copy = open;
+  MapRayCaster assigned(PolygonMap::fromRings({ outer }));
+  assigned = pillared;
+  const Vec2 p(5.0, 5.0);
+  for (int round = 0; round < 3; ++round)
+  {
+    EXPECT_TRUE(open.isFree(p));
+    EXPECT_FALSE(pillared.isFree(p));
+    EXPECT_TRUE(copy.isFree(p));
+    EXPECT_FALSE(assigned.isFree(p));
+    EXPECT_TRUE(open.isFree(p));
+    EXPECT_TRUE(open.isFree(p));
+    EXPECT_TRUE(pillared.isFree(Vec2(2.0, 2.0)));
+  }
+}
+
 TEST(RayCaster, BoxQueriesEqualBruteForce)
 {
   for (const NamedMap& named : allMaps())

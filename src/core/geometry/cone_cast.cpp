@@ -26,11 +26,6 @@ struct SectorPoint
   int hi_side = 0;
 };
 
-double cross(const Vec2& a, const Vec2& b)
-{
-  return a.x() * b.y() - a.y() * b.x();
-}
-
 /// Clips the parameter interval [lo, hi] of a + t (b - a) to the half-plane cross(n, p - o) >= 0;
 /// @p side is recorded in lo_side or hi_side when the boundary line moves that end.
 bool clipHalfPlane(const Vec2& origin, const Vec2& n, const Segment& seg, int side, SectorPoint& out)

@@ -60,14 +60,6 @@ Vec2 transformPoint(const Pose2& a, const Vec2& p)
   return Vec2(a.x + c * p.x() - s * p.y(), a.y + s * p.x() + c * p.y());
 }
 
-namespace
-{
-double cross(const Vec2& u, const Vec2& v)
-{
-  return u.x() * v.y() - u.y() * v.x();
-}
-}  // namespace
-
 double rayParallelSegmentDistance(const Vec2& origin, const Vec2& dir, const Segment& seg)
 {
   // A hit only when collinear, then at the nearest point ahead of the origin.

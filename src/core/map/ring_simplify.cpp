@@ -7,10 +7,6 @@
 namespace fdml_localization {
 namespace core {
 namespace {
-double cross(const Vec2 &a, const Vec2 &b) {
-  return a.x() * b.y() - a.y() * b.x();
-}
-
 /// Distance from p to the segment ab [m].
 double distanceToSegment(const Vec2 &p, const Vec2 &a, const Vec2 &b) {
   const Vec2 ab = b - a;

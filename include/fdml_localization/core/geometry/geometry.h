@@ -112,6 +112,12 @@ struct Box2
   }
 };
 
+/// z component of the cross product a x b.
+inline double cross(const Vec2& a, const Vec2& b)
+{
+  return a.x() * b.y() - a.y() * b.x();
+}
+
 /// raySegmentDistance() for a ray parallel to the segment (|dir x e| <= 1e-14 |e|, e = b - a).
 double rayParallelSegmentDistance(const Vec2& origin, const Vec2& dir, const Segment& seg);
 
@@ -128,14 +134,14 @@ inline double raySegmentDistance(const Vec2& origin, const Vec2& dir, const Segm
   // Inline: the innermost loop of every ray cast.
   const Vec2 e = seg.b - seg.a;
   const Vec2 w = seg.a - origin;
-  const double denom = dir.x() * e.y() - dir.y() * e.x();
+  const double denom = cross(dir, e);
   // Parallel when |dir x e| <= 1e-14 |e| (compared squared: no square root on the hot path).
   if (denom * denom <= 1e-28 * e.squaredNorm())
   {
     return rayParallelSegmentDistance(origin, dir, seg);
   }
-  const double t = (w.x() * e.y() - w.y() * e.x()) / denom;      // along the ray
-  const double u = (w.x() * dir.y() - w.y() * dir.x()) / denom;  // along the segment, in [0, 1] on it
+  const double t = cross(w, e) / denom;    // along the ray
+  const double u = cross(w, dir) / denom;  // along the segment, in [0, 1] on it
   const double tol = 1e-12;
   if (t < -tol || u < -tol || u > 1.0 + tol)
   {

@@ -26,11 +26,6 @@ Box2 sweep(const Box2& positions, const Box2& arc, double inflate)
   return out;
 }
 
-double cross(const Vec2& a, const Vec2& b)
-{
-  return a.x() * b.y() - a.y() * b.x();
-}
-
 /**
  * True when one map edge stops every ray from every point of @p sensors in every heading of
  * [a0, a1] [rad] nearer than @p reach [m]: the edge the centre's middle ray hits, with every

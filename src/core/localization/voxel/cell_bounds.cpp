@@ -113,7 +113,7 @@ bool simplePieces(const MapRayCaster& map, const Box2& box, double margin, std::
   }
   const HalfPlane h1 = freeSide(*e1, margin);
   const HalfPlane h2 = freeSide(*e2, margin);
-  if (cross2(e1->b - e1->a, e2->b - e2->a) >= 0.0)
+  if (cross(e1->b - e1->a, e2->b - e2->a) >= 0.0)
   {
     addPiece(clipPolygon(clipPolygon(square, h1), h2), pieces);  // convex corner of free space
   }

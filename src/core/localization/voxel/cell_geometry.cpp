@@ -78,7 +78,7 @@ void convexHull(std::vector<Vec2>& points, std::vector<Vec2>& hull)
   }
   hull.resize(2 * points.size());
   std::size_t k = 0;
-  auto turn = [&](const Vec2& o, const Vec2& a, const Vec2& b) { return cross2(a - o, b - o); };
+  auto turn = [&](const Vec2& o, const Vec2& a, const Vec2& b) { return cross(a - o, b - o); };
   for (const Vec2& p : points)
   {
     while (k >= 2 && turn(hull[k - 2], hull[k - 1], p) <= 0.0)

@@ -156,7 +156,7 @@ bool runAhead(const Frame& f, const Run& run)
     }
     for (const Vec2& v : f.piece)
     {
-      if (!(cross2(d, v - s.a) > kAhead * d.norm()))
+      if (!(cross(d, v - s.a) > kAhead * d.norm()))
       {
         return false;
       }
@@ -185,7 +185,7 @@ static bool segmentAhead(const Frame& f, const Vec2& p, const Vec2& q, const Seg
     return false;
   }
   return std::all_of(f.piece.begin(), f.piece.end(),
-                     [&](const Vec2& v) { return cross2(d, v - edge.a) > kAhead * d.norm(); });
+                     [&](const Vec2& v) { return cross(d, v - edge.a) > kAhead * d.norm(); });
 }
 
 /// Splits the runs into chains whose every segment passes segmentAhead(), clipping the others to
@@ -259,7 +259,7 @@ bool bracketsEveryRay(const Frame& f, const std::vector<Run>& chains)
       {
         for (int j = 0; j < 2; ++j)
         {
-          const double side = cross2(f.u[j], z - v);
+          const double side = cross(f.u[j], z - v);
           all_right = all_right && side <= 0.0;
           all_left = all_left && side >= 0.0;
         }
@@ -284,8 +284,8 @@ static bool overlap(const Frame& f, const Run& a, const Run& b)
       bool right = false;
       for (const Vec2& z : pointsOf(f, l))
       {
-        const double s0 = cross2(f.u[0], z - y);
-        const double s1 = cross2(f.u[1], z - y);
+        const double s0 = cross(f.u[0], z - y);
+        const double s1 = cross(f.u[1], z - y);
         left = left || (s0 >= 0.0 && s1 >= 0.0);
         right = right || (s0 <= 0.0 && s1 <= 0.0);
       }

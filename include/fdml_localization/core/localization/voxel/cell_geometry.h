@@ -20,12 +20,6 @@ struct HalfPlane
   double offset = 0.0;
 };
 
-/// z component of the cross product a x b.
-inline double cross2(const Vec2& a, const Vec2& b)
-{
-  return a.x() * b.y() - a.y() * b.x();
-}
-
 /// The part of the convex polygon @p poly (any orientation) inside @p h (Sutherland-Hodgman).
 std::vector<Vec2> clipPolygon(const std::vector<Vec2>& poly, const HalfPlane& h);
 

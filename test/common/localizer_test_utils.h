@@ -6,6 +6,7 @@
 #include "fdml_localization/core/localization/localizer.h"
 #include "fdml_localization/core/localization/robust_search.h"
 #include "fdml_localization/core/map/map_io.h"
+#include "fdml_localization/core/localization/voxel/voxel_engine.h"
 #include "fdml_localization/core/localization/voxel/voxel_grid.h"
 
 #include <unistd.h>
@@ -181,6 +182,60 @@ inline bool truthInLeaves(const std::vector<LeafBox>& leaves, const Pose2& truth
   }
   return false;
 }
+
+/// The most readings any of @p per_axis^3 poses spread over @p box (corners included) explains
+/// within @p tolerance [m] (readingResidual()): a lower bound of the box's consensus, which a
+/// sound upper bound (the box test, a count field) never falls below.
+inline int sampledConsensus(const MapRayCaster& map, const std::vector<Reading>& readings, const PoseBox& box,
+                            double tolerance, int per_axis = 3)
+{
+  int best = 0;
+  for (int i = 0; i < per_axis * per_axis * per_axis; ++i)
+  {
+    const auto at = [&](double lo, double hi, int j) { return lo + (hi - lo) * j / (per_axis - 1); };
+    const Pose2 pose(at(box.x0, box.x1, i % per_axis), at(box.y0, box.y1, (i / per_axis) % per_axis),
+                     at(box.t0, box.t1, i / (per_axis * per_axis)));
+    int explained = 0;
+    for (const Reading& r : readings)
+    {
+      const double residual = readingResidual(map, pose, r);
+      explained += std::abs(residual) <= tolerance ? 1 : 0;
+    }
+    best = std::max(best, explained);
+  }
+  return best;
+}
+
+/// A voxel engine's localization of ten readings in a circle, three of them corrupted, from a
+/// random pose in the L room (resolution 40 x 32): its conservative count field and readings.
+struct CorruptedLRoomRun
+{
+  std::shared_ptr<const MapRayCaster> map = lRoomMap();
+  LocalizerOptions options;
+  std::unique_ptr<VoxelEngine> engine;
+  std::vector<Reading> readings;
+
+  explicit CorruptedLRoomRun(std::uint64_t seed)
+  {
+    options.resolution = 40;
+    options.theta_resolution = 32;
+    options.threads = 2;
+    engine = std::make_unique<VoxelEngine>(map, options);
+    std::mt19937_64 rng(seed);
+    std::vector<Pose2> offsets;
+    for (int i = 0; i < 10; ++i)
+    {
+      offsets.emplace_back(0.0, 0.0, kTwoPi * i / 10);
+    }
+    readings = exactReadings(*map, randomFreePose(*map, rng, 0.2), offsets);
+    std::uniform_real_distribution<double> wrong(0.3, 4.0);
+    for (int i : { 1, 4, 7 })
+    {
+      readings[i].range = wrong(rng);
+    }
+    engine->localize(readings);
+  }
+};
 
 }  // namespace test
 }  // namespace core

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <numeric>
 
 namespace fdml_localization
 {
@@ -31,10 +30,61 @@ private:
   std::vector<std::uint64_t> words_;
 };
 
+/// forEachNeighbour() of voxel @p v, in the same order, until @p fn returns false; interior
+/// voxels by fixed index offsets.
+class Neighbours
+{
+public:
+  explicit Neighbours(const GridSpec& spec) : spec_(spec)
+  {
+    const long nx = spec.nx;
+    const long plane = nx * spec.ny;
+    for (long dt = -1; dt <= 1; ++dt)
+    {
+      for (long dy = -1; dy <= 1; ++dy)
+      {
+        for (long dx = -1; dx <= 1; ++dx)
+        {
+          if (dx != 0 || dy != 0 || dt != 0)
+          {
+            offsets_.push_back(dt * plane + dy * nx + dx);
+          }
+        }
+      }
+    }
+  }
+
+  template <typename Fn>
+  void until(std::size_t v, Fn&& fn) const
+  {
+    int ix = 0;
+    int iy = 0;
+    int it = 0;
+    spec_.unindex(v, ix, iy, it);
+    if (ix > 0 && ix + 1 < spec_.nx && iy > 0 && iy + 1 < spec_.ny && it > 0 && it + 1 < spec_.nt)
+    {
+      for (long d : offsets_)
+      {
+        if (!fn(static_cast<std::size_t>(static_cast<long>(v) + d)))
+        {
+          return;
+        }
+      }
+      return;
+    }
+    bool go = true;
+    forEachNeighbour(spec_, ix, iy, it, [&](std::size_t w) { go = go && fn(w); });
+  }
+
+private:
+  const GridSpec& spec_;
+  std::vector<long> offsets_;
+};
+
 /// Breadth-first flood of the voxels accepted by @p inside, from @p seed (already accepted).
 template <typename Inside, typename Visit>
-void flood(const GridSpec& spec, std::size_t seed, BitFlags& visited, std::vector<std::size_t>& queue, Inside&& inside,
-           Visit&& visit)
+void flood(const Neighbours& neighbours, std::size_t seed, BitFlags& visited, std::vector<std::size_t>& queue,
+           Inside&& inside, Visit&& visit)
 {
   queue.clear();
   queue.push_back(seed);
@@ -43,16 +93,13 @@ void flood(const GridSpec& spec, std::size_t seed, BitFlags& visited, std::vecto
   {
     const std::size_t v = queue[head];
     visit(v);
-    int ix = 0;
-    int iy = 0;
-    int it = 0;
-    spec.unindex(v, ix, iy, it);
-    forEachNeighbour(spec, ix, iy, it, [&](std::size_t u) {
+    neighbours.until(v, [&](std::size_t u) {
       if (!visited.test(u) && inside(u))
       {
         visited.set(u);
         queue.push_back(u);
       }
+      return true;
     });
   }
 }
@@ -68,13 +115,25 @@ void computeCentroid(const GridSpec& spec, VoxelCluster& cluster)
   double sy = 0.0;
   double sc = 0.0;
   double ss = 0.0;
+  // A large cluster reads its headings' cosines and sines from a table (the same values).
+  std::vector<double> cosines;
+  std::vector<double> sines;
+  if (cluster.voxels.size() > static_cast<std::size_t>(spec.nt))
+  {
+    for (int it = 0; it < spec.nt; ++it)
+    {
+      cosines.push_back(std::cos(spec.centreTheta(it)));
+      sines.push_back(std::sin(spec.centreTheta(it)));
+    }
+  }
   for (std::size_t v : cluster.voxels)
   {
     const Pose2 c = spec.centre(v);
     sx += c.x;
     sy += c.y;
-    sc += std::cos(c.theta);
-    ss += std::sin(c.theta);
+    const std::size_t it = v / (static_cast<std::size_t>(spec.nx) * spec.ny);
+    sc += cosines.empty() ? std::cos(c.theta) : cosines[it];
+    ss += sines.empty() ? std::sin(c.theta) : sines[it];
   }
   const double n = static_cast<double>(cluster.voxels.size());
   cluster.centroid = Pose2(sx / n, sy / n, wrapAngle(std::atan2(ss, sc)));
@@ -98,6 +157,7 @@ std::vector<VoxelCluster> connectedComponents(const GridSpec& spec, const std::v
 {
   std::vector<VoxelCluster> clusters;
   BitFlags visited(count.size());
+  const Neighbours neighbours(spec);
   std::vector<std::size_t> queue;
   auto inside = [&](std::size_t u) { return count[u] >= level; };
   for (std::size_t v = 0; v < count.size(); ++v)
@@ -107,7 +167,7 @@ std::vector<VoxelCluster> connectedComponents(const GridSpec& spec, const std::v
       continue;
     }
     VoxelCluster cluster;
-    flood(spec, v, visited, queue, inside,
+    flood(neighbours, v, visited, queue, inside,
           [&](std::size_t u) { cluster.peak_count = std::max<int>(cluster.peak_count, count[u]); });
     cluster.voxels = queue;
     computeCentroid(spec, cluster);
@@ -128,7 +188,7 @@ std::size_t componentSize(const GridSpec& spec, const std::vector<std::uint8_t>&
   BitFlags visited(count.size());
   std::vector<std::size_t> queue;
   flood(
-      spec, seed, visited, queue, [&](std::size_t u) { return count[u] >= level; }, [](std::size_t) {});
+      Neighbours(spec), seed, visited, queue, [&](std::size_t u) { return count[u] >= level; }, [](std::size_t) {});
   return queue.size();
 }
 
@@ -137,6 +197,7 @@ std::vector<std::size_t> componentSizes(const GridSpec& spec, const std::vector<
 {
   std::vector<std::size_t> sizes(seeds.size(), 0);
   BitFlags visited(count.size());
+  const Neighbours neighbours(spec);
   std::vector<std::size_t> queue;
   for (std::size_t i = 0; i < seeds.size(); ++i)
   {
@@ -146,7 +207,7 @@ std::vector<std::size_t> componentSizes(const GridSpec& spec, const std::vector<
       continue;
     }
     flood(
-        spec, seed, visited, queue, [&](std::size_t u) { return count[u] >= level; }, [](std::size_t) {});
+        neighbours, seed, visited, queue, [&](std::size_t u) { return count[u] >= level; }, [](std::size_t) {});
     // Every later seed flooded now lies in this component.
     for (std::size_t j = i; j < seeds.size(); ++j)
     {
@@ -159,46 +220,69 @@ std::vector<std::size_t> componentSizes(const GridSpec& spec, const std::vector<
   return sizes;
 }
 
-std::vector<VoxelCluster> regionalMaxima(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
-                                         const std::vector<std::size_t>& candidates)
+std::vector<VoxelCluster> regionalPlateaus(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
+                                           const std::vector<std::size_t>& candidates)
 {
   std::vector<VoxelCluster> clusters;
-  BitFlags visited(count.size());
+  // A flood stops at the first voxel above the level, or in a plateau already found not to be a
+  // maximum (`lower`): its voxels join `lower`. Floods stay in their plateau, so a finished one
+  // holds all of it, from the same first voxel and in the same order as a full flood.
+  BitFlags seen(count.size());
+  BitFlags lower(count.size());
+  const Neighbours neighbours(spec);
   std::vector<std::size_t> queue;
   for (std::size_t v : candidates)
   {
-    if (visited.test(v) || count[v] != level)
+    if (seen.test(v) || count[v] != level)
     {
       continue;
     }
+    queue.assign(1, v);
+    seen.set(v);
     bool is_maximum = true;
-    flood(
-        spec, v, visited, queue, [&](std::size_t u) { return count[u] == level; },
-        [&](std::size_t u) {
-          if (!is_maximum)
-          {
-            return;
-          }
-          int ix = 0;
-          int iy = 0;
-          int it = 0;
-          spec.unindex(u, ix, iy, it);
-          forEachNeighbour(spec, ix, iy, it, [&](std::size_t w) {
-            if (count[w] > level)
-            {
-              is_maximum = false;
-            }
-          });
-        });
+    for (std::size_t head = 0; head < queue.size() && is_maximum; ++head)
+    {
+      neighbours.until(queue[head], [&](std::size_t w) {
+        if (count[w] < level)
+        {
+          return true;
+        }
+        if (count[w] > level || lower.test(w))
+        {
+          is_maximum = false;
+          return false;
+        }
+        if (!seen.test(w))
+        {
+          seen.set(w);
+          queue.push_back(w);
+        }
+        return true;
+      });
+    }
     if (!is_maximum)
     {
+      for (std::size_t u : queue)
+      {
+        lower.set(u);
+      }
       continue;
     }
     VoxelCluster cluster;
     cluster.voxels = queue;
     cluster.peak_count = level;
-    computeCentroid(spec, cluster);
     clusters.push_back(std::move(cluster));
+  }
+  return clusters;
+}
+
+std::vector<VoxelCluster> regionalMaxima(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
+                                         const std::vector<std::size_t>& candidates)
+{
+  std::vector<VoxelCluster> clusters = regionalPlateaus(spec, count, level, candidates);
+  for (VoxelCluster& cluster : clusters)
+  {
+    computeCentroid(spec, cluster);
   }
   std::stable_sort(clusters.begin(), clusters.end(),
                    [](const VoxelCluster& a, const VoxelCluster& b) { return a.voxels.size() > b.voxels.size(); });
@@ -269,19 +353,6 @@ std::vector<std::vector<std::size_t>> voxelsByCount(const std::vector<std::uint8
   forEachVoxelIn(count, lo, static_cast<unsigned>(std::min(max_level, 255)),
                  [&](std::size_t v) { buckets[count[v]].push_back(v); });
   return buckets;
-}
-
-std::vector<std::size_t> voxelsAtLeast(const std::vector<std::uint8_t>& count, int level)
-{
-  std::vector<std::size_t> voxels;
-  if (level <= 0)
-  {
-    voxels.resize(count.size());
-    std::iota(voxels.begin(), voxels.end(), std::size_t{ 0 });
-    return voxels;
-  }
-  forEachVoxelIn(count, static_cast<unsigned>(std::min(level, 256)), 255u, [&](std::size_t v) { voxels.push_back(v); });
-  return voxels;
 }
 
 }  // namespace core

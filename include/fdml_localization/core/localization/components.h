@@ -73,6 +73,11 @@ std::size_t componentSize(const GridSpec& spec, const std::vector<std::uint8_t>&
 std::vector<std::size_t> componentSizes(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
                                         const std::vector<std::size_t>& seeds);
 
+/// The plateaus of regionalMaxima() in the order they are found (first candidate first), without
+/// centroids.
+std::vector<VoxelCluster> regionalPlateaus(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
+                                           const std::vector<std::size_t>& candidates);
+
 /**
  * @brief The regional maxima of the count field at exactly @p level: connected plateaus of
  *        voxels with count == level none of whose neighbours has a higher count. Every count
@@ -86,9 +91,6 @@ std::vector<VoxelCluster> regionalMaxima(const GridSpec& spec, const std::vector
 /// max(min_level, 1) <= c <= max_level.
 std::vector<std::vector<std::size_t>> voxelsByCount(const std::vector<std::uint8_t>& count, int min_level,
                                                     int max_level);
-
-/// The voxels (ascending) whose count reaches @p level (all of them when @p level <= 0).
-std::vector<std::size_t> voxelsAtLeast(const std::vector<std::uint8_t>& count, int level);
 
 }  // namespace core
 }  // namespace fdml_localization

@@ -22,7 +22,7 @@ namespace core
 namespace
 {
 
-/// byte_spread[b] has byte j = bit j of b: adds 8 voxels' bits to 8 count bytes at once.
+/// byte_spread[b] has byte j = bit j of b: spreads 8 voxels' bits to 8 count bytes at once.
 struct ByteSpread
 {
   std::uint64_t table[256];
@@ -40,6 +40,37 @@ struct ByteSpread
   }
 };
 const ByteSpread kByteSpread;
+
+/**
+ * @brief Writes to out[0, n) how many of @p rows hold each of the 64 voxels of their word @p w:
+ *        the counts are added bit-sliced (plane b holds bit b of every voxel's count, at most
+ *        255 rows), then spread to bytes eight voxels at a time.
+ */
+void writeWordCounts(const std::vector<const std::uint64_t*>& rows, int w, std::uint8_t* out, int n)
+{
+  std::uint64_t planes[8] = {};
+  int used = 0;
+  for (const std::uint64_t* row : rows)
+  {
+    std::uint64_t x = row[w];
+    for (int b = 0; x != 0 && b < 8; ++b)
+    {
+      const std::uint64_t carry = planes[b] & x;
+      planes[b] ^= x;
+      x = carry;
+      used = std::max(used, b + 1);
+    }
+  }
+  for (int j = 0; used > 0 && 8 * j < n; ++j)
+  {
+    std::uint64_t eight = 0;
+    for (int b = 0; b < used; ++b)
+    {
+      eight += kByteSpread.table[(planes[b] >> (8 * j)) & 0xffu] << b;
+    }
+    std::memcpy(out + 8 * j, &eight, static_cast<std::size_t>(std::min(8, n - 8 * j)));
+  }
+}
 
 /// The voxels whose cell may meet @p region, every heading (conservative: a "no" is exact).
 VoxelSet regionMask(const MapRayCaster& region, const GridSpec& spec)
@@ -210,50 +241,28 @@ std::vector<VoxelSet> VoxelEngine::paperPreimages(const std::vector<Reading>& re
 void VoxelEngine::countField(const std::vector<VoxelSet>& sets, std::vector<std::uint8_t>& count) const
 {
   count.assign(spec_.voxelCount(), 0);
+  if (sets.empty())
+  {
+    return;
+  }
   const int nx = spec_.nx;
   const int ny = spec_.ny;
   const int nt = spec_.nt;
+  const int words = sets.front().wordsPerRow();
 #pragma omp parallel for schedule(static) num_threads(threads())
   for (int it = 0; it < nt; ++it)
   {
-    for (const VoxelSet& set : sets)
+    std::vector<const std::uint64_t*> rows(sets.size());
+    for (int iy = 0; iy < ny; ++iy)
     {
-      for (int iy = 0; iy < ny; ++iy)
+      for (std::size_t i = 0; i < sets.size(); ++i)
       {
-        const std::uint64_t* row = set.row(iy, it);
-        std::uint8_t* out = count.data() + spec_.index(0, iy, it);
-        for (int k = 0; k < set.wordsPerRow(); ++k)
-        {
-          const std::uint64_t w = row[k];
-          if (w == 0)
-          {
-            continue;
-          }
-          for (int j = 0; j < 8; ++j)
-          {
-            const auto byte = static_cast<unsigned>((w >> (8 * j)) & 0xffu);
-            const int ix = 64 * k + 8 * j;
-            if (byte == 0)
-            {
-              continue;
-            }
-            if (ix + 8 <= nx)
-            {
-              // Eight counts at once: no byte overflows (at most 255 sets).
-              std::uint64_t eight = 0;
-              std::memcpy(&eight, out + ix, 8);
-              eight += kByteSpread.table[byte];
-              std::memcpy(out + ix, &eight, 8);
-            }
-            else
-            {
-              for (int b = 0; b < 8 && ix + b < nx; ++b)
-              {
-                out[ix + b] = static_cast<std::uint8_t>(out[ix + b] + ((byte >> b) & 1u));
-              }
-            }
-          }
-        }
+        rows[i] = sets[i].row(iy, it);
+      }
+      std::uint8_t* out = count.data() + spec_.index(0, iy, it);
+      for (int w = 0; w < words; ++w)
+      {
+        writeWordCounts(rows, w, out + 64 * w, std::min(64, nx - 64 * w));
       }
     }
   }

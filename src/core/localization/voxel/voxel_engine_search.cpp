@@ -2,6 +2,8 @@
 // search's seeds (maximal hypotheses and count peaks) for the shared robust search (seed_search.h).
 #include "fdml_localization/core/localization/voxel/voxel_engine.h"
 
+#include "fdml_localization/core/localization/voxel/box_screen.h"
+#include "fdml_localization/core/localization/voxel/count_buckets.h"
 #include "fdml_localization/core/localization/ranking.h"
 #include "fdml_localization/core/localization/robust_search.h"
 #include "fdml_localization/core/localization/seed_search.h"
@@ -35,59 +37,20 @@ constexpr std::size_t kSampledVoxels = 512;
 /// ... which gives three distinct seeds from this many voxels on (smaller ones one).
 constexpr std::size_t kLargePlateau = 16;
 
-/// The voxels of a count field by count (voxelsByCount()), bucketed when a level is first asked
-/// for: the search's first levels in one pass over the field, the lower ones (holding most
-/// voxels, and rarely reached) in a second.
-class CountBuckets
-{
-public:
-  CountBuckets(const std::vector<std::uint8_t>& count, int lowest, int k)
-    : count_(count), lowest_(lowest), k_(k), built_from_(k + 1), buckets_(static_cast<std::size_t>(k) + 1)
-  {}
-
-  /// The voxels (ascending) whose count is @p level; none below the lowest level.
-  const std::vector<std::size_t>& at(int level)
-  {
-    if (level < lowest_ || level > k_)
-    {
-      return none_;
-    }
-    if (level < built_from_)
-    {
-      const int from = built_from_ > k_ ? std::max(lowest_, level - 2) : lowest_;
-      std::vector<std::vector<std::size_t>> more = voxelsByCount(count_, from, built_from_ - 1);
-      for (int l = from; l < built_from_; ++l)
-      {
-        buckets_[l] = std::move(more[l]);
-      }
-      built_from_ = from;
-    }
-    return buckets_[level];
-  }
-
-private:
-  const std::vector<std::uint8_t>& count_;
-  int lowest_;
-  int k_;
-  int built_from_;  ///< the levels from here to k_ are bucketed
-  std::vector<std::vector<std::size_t>> buckets_;
-  const std::vector<std::size_t> none_;
-};
-
 /// The voxel engine's seeds, level by level: every locally maximal set of readings of the
 /// seeding's sample preimages (hypothesis_seeds.h) and, because that test can miss the truth's
 /// voxel next to a discontinuity of h, the count peaks of their dilation.
 class VoxelSeeds : public SeedSource
 {
 public:
-  VoxelSeeds(const VoxelEngine& engine, const MapRayCaster& map, const std::vector<Reading>& readings, double gate,
-             int lowest, int k, StageTimes& times)
+  VoxelSeeds(const VoxelEngine& engine, const BoxScreen& screen, double gate, int lowest, int k, StageTimes& times)
     : engine_(engine)
-    , map_(map)
-    , readings_(readings)
+    , map_(screen.map)
+    , readings_(screen.readings)
+    , screen_(screen)
     , gate_(gate)
     , times_(times)
-    , conservative_buckets_(engine.lastCount(), lowest, k)
+    , conservative_(engine.grid(), engine.lastCount(), lowest, k)
     , buckets_(engine.lastSeedCount(), lowest, k)
     , raw_buckets_(engine.lastRawCount(), lowest, k)
   {}
@@ -113,13 +76,13 @@ public:
 
 private:
   /// The sample tests can miss the truth's voxel next to a discontinuity of h; the conservative
-  /// count field never does: each of its regional maxima also gives the voxels (of some spread
-  /// over it) agreeing best with the readings.
+  /// count field never does: each of its regional maxima the box test lets reach the level
+  /// (ScreenedCount) also gives the voxels (of some spread over it) agreeing best with the
+  /// readings.
   void addConservativeSeeds(int level, std::vector<SearchSeed>& seeds)
   {
     const GridSpec& spec = engine_.grid();
-    const std::vector<VoxelCluster> maxima =
-        regionalMaxima(spec, engine_.lastCount(), level, conservative_buckets_.at(level));
+    const std::vector<VoxelCluster> maxima = conservative_.maximaAt(level, screen_);
     std::vector<std::vector<Pose2>> starts(maxima.size());
 #pragma omp parallel for schedule(dynamic, 4) num_threads(engine_.threads()) if (maxima.size() >= 8)
     for (long m = 0; m < static_cast<long>(maxima.size()); ++m)
@@ -185,9 +148,10 @@ private:
   const VoxelEngine& engine_;
   const MapRayCaster& map_;
   const std::vector<Reading>& readings_;
+  BoxScreen screen_;
   double gate_;
   StageTimes& times_;
-  CountBuckets conservative_buckets_;
+  ScreenedCount conservative_;
   CountBuckets buckets_;
   CountBuckets raw_buckets_;
 };
@@ -225,8 +189,10 @@ void VoxelEngine::localizeRobust(const std::vector<Reading>& readings, Result& r
 {
   const int k = static_cast<int>(readings.size());
   const int lowest = options_.min_inliers > 0 ? options_.min_inliers : 3;
-  VoxelSeeds seeds(*this, *map_, readings, seedGate(readings, options_, SeedScale{ spec_.cell, spec_.thetaStep() }),
-                   lowest, k, result.times);
+  const BoxScreen screen{ *map_, readings, std::max(options_.range_tolerance, options_.agreement_tolerance),
+                          threads() };
+  VoxelSeeds seeds(*this, screen, seedGate(readings, options_, SeedScale{ spec_.cell, spec_.thetaStep() }), lowest, k,
+                   result.times);
   SeedSearchOutcome found =
       robustSearch(seeds, *map_, readings, options_, SeedScale{ spec_.cell, spec_.thetaStep() }, result.times);
   result.min_inliers_used = found.min_inliers_used;
@@ -246,28 +212,9 @@ void VoxelEngine::localizeRobust(const std::vector<Reading>& readings, Result& r
   {
     const int target = netConsensus(result.candidates.front());
     // The box test bounds a voxel's consensus tighter than the count's distance bounds (and it
-    // stops early where the target is out of reach). One test per thread: neighbouring voxels are
-    // mostly ruled out by the same reading (BoxConsensusTest). Only the voxels passing become leaves.
-    const std::vector<std::size_t> reaching = voxelsAtLeast(count_, target);
-    std::vector<int> bounds(reaching.size(), 0);
-#pragma omp parallel num_threads(threads()) if (reaching.size() >= 1024)
-    {
-      BoxConsensusTest test(*map_, readings, options_.range_tolerance);
-#pragma omp for schedule(dynamic, 256)
-      for (long j = 0; j < static_cast<long>(reaching.size()); ++j)
-      {
-        const std::size_t v = reaching[static_cast<std::size_t>(j)];
-        bounds[j] = std::min<int>(count_[v], test.bound(voxelBox(spec_, v), target));
-      }
-    }
-    std::vector<LeafBox> leaves;
-    for (std::size_t j = 0; j < reaching.size(); ++j)
-    {
-      if (bounds[j] >= target)
-      {
-        leaves.push_back(voxelLeaf(spec_, reaching[j], bounds[j]));
-      }
-    }
+    // stops early where the target is out of reach): only the voxels passing become leaves.
+    const std::vector<LeafBox> leaves =
+        reachingLeaves(spec_, count_, target, BoxScreen{ *map_, readings, options_.range_tolerance, threads() });
     const RefinementSettings settings = latticeRefinement(options_, spec_.cell, spec_.thetaStep());
     fillUncoveredRegions(*map_, leaves, spec_.nt, readings, options_, settings, result);
     settleInNearBasins(*map_, readings, options_, settings, result.candidates);

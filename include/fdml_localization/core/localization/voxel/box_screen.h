@@ -1,0 +1,74 @@
+/**
+ * @file box_screen.h
+ * @brief The box test (BoxConsensusTest) over the voxel engine's grid: which voxels reaching a
+ *        consensus in the count field may reach it by the box test, a tighter bound. Blocks of
+ *        voxels are tested first, from 8 x 8 x 8 down, halving, so a block whose box cannot
+ *        explain the consensus rules out all its voxels with one test: over 99 % of the voxels a
+ *        count field lets reach a low consensus fail it.
+ */
+#pragma once
+
+#include "fdml_localization/core/localization/adaptive/adaptive_search.h"
+#include "fdml_localization/core/localization/localizer.h"
+#include "fdml_localization/core/localization/voxel/voxel_grid.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace fdml_localization
+{
+namespace core
+{
+/// The box test's inputs (the map and readings must outlive it).
+struct BoxScreen
+{
+  const MapRayCaster& map;
+  const std::vector<Reading>& readings;
+  double tolerance = 0.0;  ///< the box test's range tolerance [m]
+  int threads = 1;
+};
+
+/// Which voxels screenVoxels() tests: those with lo <= count <= hi, against @p needed readings.
+struct VoxelScreen
+{
+  int lo = 0;
+  int hi = 255;
+  int needed = 0;
+  bool with_failed = false;  ///< return the voxels that fail too
+};
+
+/// A voxel's verdict: a sound bound of the readings a pose of it explains, the box test's
+/// (BoxConsensusTest::bound()) when it passes (reaches the readings needed), else the readings
+/// needed - 1 (its box, or a block holding it, was ruled out).
+struct VoxelVerdict
+{
+  std::size_t voxel = 0;
+  int bound = -1;
+};
+
+/**
+ * @brief The verdicts (ascending voxel) on the voxels @p which selects in @p count: those whose
+ *        box may explain which.needed readings, and with which.with_failed the others. A voxel
+ *        fails with a block holding it whose box cannot explain them (no pose in it can: the box
+ *        test is sound, though not monotone, so a voxel's own box can pass where a block's
+ *        failed), or by its own box.
+ */
+std::vector<VoxelVerdict> screenVoxels(const GridSpec& spec, const std::vector<std::uint8_t>& count,
+                                       const VoxelScreen& which, const BoxScreen& screen);
+
+/// The verdicts (ascending voxel, failed ones too) on the voxels of @p members (listed in
+/// @p voxels, any order) at @p needed readings, as above.
+std::vector<VoxelVerdict> screenVoxels(const GridSpec& spec, const VoxelSet& members,
+                                       const std::vector<std::size_t>& voxels, int needed, const BoxScreen& screen);
+
+/**
+ * @brief The voxels v of @p spec with @p count[v] >= @p target that pass screenVoxels() at
+ *        @p target readings, as leaves (voxelLeaf(), ascending v) counting min(count[v], the box
+ *        test's bound).
+ */
+std::vector<LeafBox> reachingLeaves(const GridSpec& spec, const std::vector<std::uint8_t>& count, int target,
+                                    const BoxScreen& screen);
+
+}  // namespace core
+}  // namespace fdml_localization

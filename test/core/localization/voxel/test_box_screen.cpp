@@ -1,0 +1,120 @@
+// The box test over the voxel grid (box_screen.h) against a voxel-by-voxel box test and sampled
+// poses, on count fields of real localizations: a voxel passes by its own box test, and one a
+// block ruled out holds no pose explaining the level.
+#include "fdml_localization/core/localization/voxel/box_screen.h"
+
+#include "fdml_localization/core/localization/adaptive/leaf_clustering.h"
+#include "fdml_localization/core/localization/voxel/voxel_engine.h"
+
+#include "localizer_test_utils.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+namespace fdml_localization
+{
+namespace core
+{
+namespace
+{
+using test::CorruptedLRoomRun;
+
+TEST(BoxScreen, ReachingLeavesAreTheVoxelsPassingTheirOwnBoxTest)
+{
+  for (std::uint64_t seed : { 1u, 2u, 3u })
+  {
+    const CorruptedLRoomRun run(seed);
+    const GridSpec& spec = run.engine->grid();
+    const std::vector<std::uint8_t>& count = run.engine->lastCount();
+    for (int target : { 9, 7, 5, 3 })
+    {
+      BoxConsensusTest test(*run.map, run.readings, run.options.range_tolerance);
+      std::vector<std::pair<std::size_t, int>> expected;
+      std::size_t counted = 0;
+      for (std::size_t v = 0; v < count.size(); ++v)
+      {
+        if (count[v] >= target)
+        {
+          ++counted;
+          const int bound = std::min<int>(count[v], test.bound(voxelBox(spec, v), target));
+          if (bound >= target)
+          {
+            expected.emplace_back(v, bound);
+          }
+        }
+      }
+      const std::vector<LeafBox> leaves =
+          reachingLeaves(spec, count, target, BoxScreen{ *run.map, run.readings, run.options.range_tolerance, 2 });
+      // The leaves are those voxels, in order, but for voxels a block ruled out (the box test is
+      // sound but not monotone: a block's bound can be below a voxel's own): no pose there
+      // explains the target.
+      std::size_t j = 0;
+      for (const auto& e : expected)
+      {
+        if (j < leaves.size() && spec.index(leaves[j].ix, leaves[j].iy, leaves[j].it) == e.first)
+        {
+          EXPECT_EQ(leaves[j++].count, e.second);
+          continue;
+        }
+        EXPECT_LT(test::sampledConsensus(*run.map, run.readings, voxelBox(spec, e.first), run.options.range_tolerance),
+                  target)
+            << "voxel " << e.first;
+      }
+      EXPECT_EQ(j, leaves.size()) << "seed " << seed << " target " << target;
+      EXPECT_GE(leaves.size(), expected.size() * 9 / 10);
+      if (target == 3)
+      {
+        // The test has work to do: the box test rules out voxels the count lets through.
+        EXPECT_LT(expected.size(), counted);
+        EXPECT_GT(expected.size(), 0u);
+      }
+    }
+  }
+}
+
+TEST(BoxScreen, EveryVoxelOfALevelGetsASoundVerdict)
+{
+  const CorruptedLRoomRun run(4);
+  const GridSpec& spec = run.engine->grid();
+  const std::vector<std::uint8_t>& count = run.engine->lastCount();
+  std::size_t passed = 0;
+  std::size_t failed = 0;
+  for (int level = 9; level >= 4; --level)
+  {
+    const std::vector<VoxelVerdict> verdicts = screenVoxels(spec, count, VoxelScreen{ level, level, level, true },
+                                                            BoxScreen{ *run.map, run.readings, 0.05, 2 });
+    std::vector<std::size_t> at_level;
+    for (std::size_t v = 0; v < count.size(); ++v)
+    {
+      if (count[v] == level)
+      {
+        at_level.push_back(v);
+      }
+    }
+    ASSERT_EQ(verdicts.size(), at_level.size()) << "level " << level;
+    BoxConsensusTest each(*run.map, run.readings, 0.05);
+    for (std::size_t j = 0; j < verdicts.size(); ++j)
+    {
+      ASSERT_EQ(verdicts[j].voxel, at_level[j]);
+      // A voxel passes by its own box test; one a block ruled out explains fewer readings.
+      const PoseBox box = voxelBox(spec, at_level[j]);
+      const bool own = each.reaches(box, level);
+      const bool passes = verdicts[j].bound >= level;
+      EXPECT_TRUE(!passes || own) << "level " << level << " voxel " << at_level[j];
+      if (!passes)
+      {
+        EXPECT_LE(test::sampledConsensus(*run.map, run.readings, box, 0.05), std::max(verdicts[j].bound, 0))
+            << "voxel " << at_level[j];
+      }
+      (passes ? passed : failed) += 1;
+    }
+  }
+  EXPECT_GT(passed, 50u);
+  EXPECT_GT(failed, 50u);
+}
+
+}  // namespace
+}  // namespace core
+}  // namespace fdml_localization

@@ -289,11 +289,6 @@ std::vector<VoxelCluster> regionalMaxima(const GridSpec& spec, const std::vector
   return clusters;
 }
 
-namespace
-{
-/// Whether any of the 8 bytes of @p word is at least @p lo (1 <= lo <= 128): a byte above
-/// lo - 1 carries into its top bit (no carry crosses a byte below 128), and a byte of 128 or
-/// more already has it.
 bool anyByteAtLeast(std::uint64_t word, unsigned lo)
 {
   constexpr std::uint64_t kOnes = 0x0101010101010101ull;
@@ -301,6 +296,16 @@ bool anyByteAtLeast(std::uint64_t word, unsigned lo)
   return (((word + kOnes * (128u - lo)) | word) & kTops) != 0;
 }
 
+bool anyByteEqual(std::uint64_t word, unsigned value)
+{
+  constexpr std::uint64_t kOnes = 0x0101010101010101ull;
+  constexpr std::uint64_t kTops = 0x8080808080808080ull;
+  const std::uint64_t x = word ^ (kOnes * value);
+  return ((x - kOnes) & ~x & kTops) != 0;
+}
+
+namespace
+{
 /// Calls @p fn(v) for every voxel v (ascending) whose count lies in [lo, hi], lo >= 1.
 template <typename Fn>
 void forEachVoxelIn(const std::vector<std::uint8_t>& count, unsigned lo, unsigned hi, Fn&& fn)

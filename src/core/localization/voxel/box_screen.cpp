@@ -1,6 +1,7 @@
 #include "fdml_localization/core/localization/voxel/box_screen.h"
 
 #include "fdml_localization/core/localization/adaptive/leaf_clustering.h"
+#include "fdml_localization/core/localization/components.h"
 
 #include <algorithm>
 #include <cstring>
@@ -44,20 +45,13 @@ public:
   /// bytes for one level (lo == hi) or from a level on (hi 255, 1 <= lo <= 128).
   bool anyInRow(int x0, int x1, int y, int t) const
   {
-    constexpr std::uint64_t kOnes = 0x0101010101010101ull;
-    constexpr std::uint64_t kTops = 0x8080808080808080ull;
     const std::size_t row = spec_.index(0, y, t);
     if (x1 - x0 == 8 && (lo_ == hi_ || (hi_ >= 255 && lo_ >= 1 && lo_ <= 128)))
     {
       std::uint64_t word = 0;
       std::memcpy(&word, count_.data() + row + static_cast<std::size_t>(x0), 8);
-      if (lo_ == hi_)
-      {
-        const std::uint64_t x = word ^ (kOnes * static_cast<std::uint64_t>(lo_));
-        return ((x - kOnes) & ~x & kTops) != 0;  // some byte of x is zero
-      }
-      // A byte above lo - 1 carries into its top bit (no carry crosses a byte below 128).
-      return (((word + kOnes * static_cast<std::uint64_t>(128 - lo_)) | word) & kTops) != 0;
+      return lo_ == hi_ ? anyByteEqual(word, static_cast<unsigned>(lo_)) :
+                          anyByteAtLeast(word, static_cast<unsigned>(lo_));
     }
     for (int x = x0; x < x1; ++x)
     {

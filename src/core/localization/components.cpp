@@ -128,12 +128,15 @@ void computeCentroid(const GridSpec& spec, VoxelCluster& cluster)
   }
   for (std::size_t v : cluster.voxels)
   {
-    const Pose2 c = spec.centre(v);
-    sx += c.x;
-    sy += c.y;
-    const std::size_t it = v / (static_cast<std::size_t>(spec.nx) * spec.ny);
-    sc += cosines.empty() ? std::cos(c.theta) : cosines[it];
-    ss += sines.empty() ? std::sin(c.theta) : sines[it];
+    int ix = 0;
+    int iy = 0;
+    int it = 0;
+    spec.unindex(v, ix, iy, it);
+    sx += spec.centreX(ix);
+    sy += spec.centreY(iy);
+    const double theta = spec.centreTheta(it);
+    sc += cosines.empty() ? std::cos(theta) : cosines[static_cast<std::size_t>(it)];
+    ss += sines.empty() ? std::sin(theta) : sines[static_cast<std::size_t>(it)];
   }
   const double n = static_cast<double>(cluster.voxels.size());
   cluster.centroid = Pose2(sx / n, sy / n, wrapAngle(std::atan2(ss, sc)));
@@ -294,14 +297,6 @@ bool anyByteAtLeast(std::uint64_t word, unsigned lo)
   constexpr std::uint64_t kOnes = 0x0101010101010101ull;
   constexpr std::uint64_t kTops = 0x8080808080808080ull;
   return (((word + kOnes * (128u - lo)) | word) & kTops) != 0;
-}
-
-bool anyByteEqual(std::uint64_t word, unsigned value)
-{
-  constexpr std::uint64_t kOnes = 0x0101010101010101ull;
-  constexpr std::uint64_t kTops = 0x8080808080808080ull;
-  const std::uint64_t x = word ^ (kOnes * value);
-  return ((x - kOnes) & ~x & kTops) != 0;
 }
 
 namespace

@@ -164,9 +164,8 @@ TEST(Components, VoxelBucketsMatchAPlainScan)
   }
 }
 
-// The word tests of eight counts against a byte-by-byte check, on random words and on words
-// holding one value among zeros and 255s.
-TEST(Components, WordTestsOfEightCountsMatchEachByte)
+// The word test of eight counts against a byte-by-byte check, on random words, some with zeros.
+TEST(Components, WordTestOfEightCountsMatchesEachByte)
 {
   std::mt19937_64 rng(13);
   for (int trial = 0; trial < 4000; ++trial)
@@ -176,22 +175,14 @@ TEST(Components, WordTestsOfEightCountsMatchEachByte)
     {
       word &= 0xff00ff00ff00ff00ull;  // zeros among random bytes
     }
-    const unsigned value = static_cast<unsigned>(rng() % 256u);
     const unsigned lo = 1u + static_cast<unsigned>(rng() % 128u);
-    bool equal = false;
     bool at_least = false;
     for (int b = 0; b < 8; ++b)
     {
-      const unsigned byte = static_cast<unsigned>((word >> (8 * b)) & 0xffu);
-      equal = equal || byte == value;
-      at_least = at_least || byte >= lo;
+      at_least = at_least || ((word >> (8 * b)) & 0xffu) >= lo;
     }
-    ASSERT_EQ(anyByteEqual(word, value), equal) << std::hex << word << " " << value;
     ASSERT_EQ(anyByteAtLeast(word, lo), at_least) << std::hex << word << " " << lo;
   }
-  EXPECT_TRUE(anyByteEqual(0xff00000000000000ull, 255u));
-  EXPECT_FALSE(anyByteEqual(0xffffffffffffff01ull, 0u));
-  EXPECT_TRUE(anyByteEqual(0x0100000000000000ull, 1u));
 }
 
 TEST(HypothesisSeeds, MaximalSetsMatchBruteForce)

@@ -92,10 +92,6 @@ std::vector<VoxelCluster> regionalMaxima(const GridSpec& spec, const std::vector
 /// more already has it. Eight counts tested at once.
 bool anyByteAtLeast(std::uint64_t word, unsigned lo);
 
-/// Whether any of the 8 bytes of @p word equals @p value (<= 255): some byte of word ^ value
-/// is zero.
-bool anyByteEqual(std::uint64_t word, unsigned value);
-
 /// The voxels of each count value: result[c] lists the voxels (ascending) with count c, for
 /// max(min_level, 1) <= c <= max_level.
 std::vector<std::vector<std::size_t>> voxelsByCount(const std::vector<std::uint8_t>& count, int min_level,

@@ -27,36 +27,33 @@ struct Block
   }
 };
 
-/// Members: the voxels whose count lies in [lo, hi].
+/// Members: the voxels whose count reaches a level.
 class CountMembers
 {
 public:
-  CountMembers(const std::vector<std::uint8_t>& count, const GridSpec& spec, int lo, int hi)
-    : count_(count), spec_(spec), lo_(lo), hi_(hi)
+  CountMembers(const std::vector<std::uint8_t>& count, const GridSpec& spec, int level)
+    : count_(count), spec_(spec), level_(level)
   {}
 
   bool has(int x, int y, int t) const
   {
-    const std::uint8_t c = count_[spec_.index(x, y, t)];
-    return c >= lo_ && c <= hi_;
+    return count_[spec_.index(x, y, t)] >= level_;
   }
 
   /// Whether voxels [x0, x1) of row (y, t) hold a member; 8 at a time by a word test of their
-  /// bytes for one level (lo == hi) or from a level on (hi 255, 1 <= lo <= 128).
+  /// bytes (anyByteAtLeast(), levels 1 to 128).
   bool anyInRow(int x0, int x1, int y, int t) const
   {
     const std::size_t row = spec_.index(0, y, t);
-    if (x1 - x0 == 8 && (lo_ == hi_ || (hi_ >= 255 && lo_ >= 1 && lo_ <= 128)))
+    if (x1 - x0 == 8 && level_ >= 1 && level_ <= 128)
     {
       std::uint64_t word = 0;
       std::memcpy(&word, count_.data() + row + static_cast<std::size_t>(x0), 8);
-      return lo_ == hi_ ? anyByteEqual(word, static_cast<unsigned>(lo_)) :
-                          anyByteAtLeast(word, static_cast<unsigned>(lo_));
+      return anyByteAtLeast(word, static_cast<unsigned>(level_));
     }
     for (int x = x0; x < x1; ++x)
     {
-      const std::uint8_t c = count_[row + static_cast<std::size_t>(x)];
-      if (c >= lo_ && c <= hi_)
+      if (count_[row + static_cast<std::size_t>(x)] >= level_)
       {
         return true;
       }
@@ -67,8 +64,7 @@ public:
 private:
   const std::vector<std::uint8_t>& count_;
   const GridSpec& spec_;
-  int lo_;
-  int hi_;
+  int level_;
 };
 
 /// Members: the voxels of a set.
@@ -288,13 +284,6 @@ std::vector<VoxelVerdict> screenMembers(const GridSpec& spec, const std::vector<
 }
 }  // namespace
 
-std::vector<VoxelVerdict> screenVoxels(const GridSpec& spec, const std::vector<std::uint8_t>& count,
-                                       const VoxelScreen& which, const BoxScreen& screen)
-{
-  return screenMembers(spec, topBlocks(spec), CountMembers(count, spec, which.lo, which.hi), which.needed,
-                       which.with_failed, screen);
-}
-
 std::vector<VoxelVerdict> screenVoxels(const GridSpec& spec, const VoxelSet& members,
                                        const std::vector<std::size_t>& voxels, int needed, const BoxScreen& screen)
 {
@@ -305,9 +294,9 @@ std::vector<LeafBox> reachingLeaves(const GridSpec& spec, const std::vector<std:
                                     const BoxScreen& screen)
 {
   const int needed = std::clamp(target, 0, 255);
-  const VoxelScreen which{ needed, 255, needed, false };
   std::vector<LeafBox> leaves;
-  for (const VoxelVerdict& v : screenVoxels(spec, count, which, screen))
+  for (const VoxelVerdict& v :
+       screenMembers(spec, topBlocks(spec), CountMembers(count, spec, needed), needed, false, screen))
   {
     leaves.push_back(voxelLeaf(spec, v.voxel, std::min<int>(count[v.voxel], v.bound)));
   }

@@ -83,16 +83,20 @@ TEST(BoxScreen, EveryVoxelOfALevelGetsASoundVerdict)
   std::size_t failed = 0;
   for (int level = 9; level >= 4; --level)
   {
-    const std::vector<VoxelVerdict> verdicts = screenVoxels(spec, count, VoxelScreen{ level, level, level, true },
-                                                            BoxScreen{ *run.map, run.readings, 0.05, 2 });
     std::vector<std::size_t> at_level;
+    VoxelSet members(spec);
     for (std::size_t v = 0; v < count.size(); ++v)
     {
       if (count[v] == level)
       {
+        int ix = 0, iy = 0, it = 0;
+        spec.unindex(v, ix, iy, it);
+        members.set(ix, iy, it);
         at_level.push_back(v);
       }
     }
+    const std::vector<VoxelVerdict> verdicts =
+        screenVoxels(spec, members, at_level, level, BoxScreen{ *run.map, run.readings, 0.05, 2 });
     ASSERT_EQ(verdicts.size(), at_level.size()) << "level " << level;
     BoxConsensusTest each(*run.map, run.readings, 0.05);
     for (std::size_t j = 0; j < verdicts.size(); ++j)

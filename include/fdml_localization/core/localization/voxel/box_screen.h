@@ -29,15 +29,6 @@ struct BoxScreen
   int threads = 1;
 };
 
-/// Which voxels screenVoxels() tests: those with lo <= count <= hi, against @p needed readings.
-struct VoxelScreen
-{
-  int lo = 0;
-  int hi = 255;
-  int needed = 0;
-  bool with_failed = false;  ///< return the voxels that fail too
-};
-
 /// A voxel's verdict: a sound bound of the readings a pose of it explains, the box test's
 /// (BoxConsensusTest::bound()) when it passes (reaches the readings needed), else the readings
 /// needed - 1 (its box, or a block holding it, was ruled out).
@@ -48,24 +39,19 @@ struct VoxelVerdict
 };
 
 /**
- * @brief The verdicts (ascending voxel) on the voxels @p which selects in @p count: those whose
- *        box may explain which.needed readings, and with which.with_failed the others. A voxel
- *        fails with a block holding it whose box cannot explain them (no pose in it can: the box
- *        test is sound, though not monotone, so a voxel's own box can pass where a block's
- *        failed), or by its own box.
+ * @brief The verdicts (ascending voxel) on the voxels of @p members (listed in @p voxels, any
+ *        order): whether each one's box may explain @p needed readings. A voxel fails with a
+ *        block holding it whose box cannot explain them (no pose in it can: the box test is
+ *        sound, though not monotone, so a voxel's own box can pass where a block's failed), or
+ *        by its own box.
  */
-std::vector<VoxelVerdict> screenVoxels(const GridSpec& spec, const std::vector<std::uint8_t>& count,
-                                       const VoxelScreen& which, const BoxScreen& screen);
-
-/// The verdicts (ascending voxel, failed ones too) on the voxels of @p members (listed in
-/// @p voxels, any order) at @p needed readings, as above.
 std::vector<VoxelVerdict> screenVoxels(const GridSpec& spec, const VoxelSet& members,
                                        const std::vector<std::size_t>& voxels, int needed, const BoxScreen& screen);
 
 /**
- * @brief The voxels v of @p spec with @p count[v] >= @p target that pass screenVoxels() at
- *        @p target readings, as leaves (voxelLeaf(), ascending v) counting min(count[v], the box
- *        test's bound).
+ * @brief The voxels v of @p spec with @p count[v] >= @p target that pass the box test at
+ *        @p target readings as screenVoxels() tests them, as leaves (voxelLeaf(), ascending v) counting min(count[v],
+ * the box test's bound).
  */
 std::vector<LeafBox> reachingLeaves(const GridSpec& spec, const std::vector<std::uint8_t>& count, int target,
                                     const BoxScreen& screen);

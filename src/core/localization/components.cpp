@@ -279,6 +279,51 @@ std::vector<VoxelCluster> regionalPlateaus(const GridSpec& spec, const std::vect
   return clusters;
 }
 
+std::vector<std::size_t> nonMaximalPlateaus(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
+                                            const std::vector<std::size_t>& above)
+{
+  BitFlags seen(count.size());
+  const Neighbours neighbours(spec);
+  std::vector<std::size_t> found;
+  auto visit = [&](std::size_t w) {
+    if (count[w] == level && !seen.test(w))
+    {
+      seen.set(w);
+      found.push_back(w);
+    }
+    return true;
+  };
+  for (std::size_t u : above)
+  {
+    neighbours.until(u, visit);
+  }
+  for (std::size_t head = 0; head < found.size(); ++head)
+  {
+    neighbours.until(found[head], visit);
+  }
+  return found;
+}
+
+std::vector<std::size_t> withNeighbourBelow(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
+                                            const std::vector<std::size_t>& voxels)
+{
+  const Neighbours neighbours(spec);
+  std::vector<std::size_t> kept;
+  for (std::size_t v : voxels)
+  {
+    bool below = false;
+    neighbours.until(v, [&](std::size_t w) {
+      below = count[w] < level;
+      return !below;
+    });
+    if (below)
+    {
+      kept.push_back(v);
+    }
+  }
+  return kept;
+}
+
 std::vector<VoxelCluster> regionalMaxima(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
                                          const std::vector<std::size_t>& candidates)
 {
@@ -290,69 +335,6 @@ std::vector<VoxelCluster> regionalMaxima(const GridSpec& spec, const std::vector
   std::stable_sort(clusters.begin(), clusters.end(),
                    [](const VoxelCluster& a, const VoxelCluster& b) { return a.voxels.size() > b.voxels.size(); });
   return clusters;
-}
-
-bool anyByteAtLeast(std::uint64_t word, unsigned lo)
-{
-  constexpr std::uint64_t kOnes = 0x0101010101010101ull;
-  constexpr std::uint64_t kTops = 0x8080808080808080ull;
-  return (((word + kOnes * (128u - lo)) | word) & kTops) != 0;
-}
-
-namespace
-{
-/// Calls @p fn(v) for every voxel v (ascending) whose count lies in [lo, hi], lo >= 1.
-template <typename Fn>
-void forEachVoxelIn(const std::vector<std::uint8_t>& count, unsigned lo, unsigned hi, Fn&& fn)
-{
-  const std::size_t n = count.size();
-  std::size_t v = 0;
-  if (lo > 255u || lo > hi)
-  {
-    return;
-  }
-  if (lo <= 128u)
-  {
-    // Skip 8 voxels at a time while none reaches lo.
-    for (; v + 8 <= n; v += 8)
-    {
-      std::uint64_t word = 0;
-      std::memcpy(&word, count.data() + v, 8);
-      if (!anyByteAtLeast(word, lo))
-      {
-        continue;
-      }
-      for (std::size_t j = v; j < v + 8; ++j)
-      {
-        if (count[j] >= lo && count[j] <= hi)
-        {
-          fn(j);
-        }
-      }
-    }
-  }
-  for (; v < n; ++v)
-  {
-    if (count[v] >= lo && count[v] <= hi)
-    {
-      fn(v);
-    }
-  }
-}
-}  // namespace
-
-std::vector<std::vector<std::size_t>> voxelsByCount(const std::vector<std::uint8_t>& count, int min_level,
-                                                    int max_level)
-{
-  std::vector<std::vector<std::size_t>> buckets(static_cast<std::size_t>(std::max(max_level, 0)) + 1);
-  if (max_level < 1)
-  {
-    return buckets;
-  }
-  const auto lo = static_cast<unsigned>(std::clamp(min_level, 1, 256));
-  forEachVoxelIn(count, lo, static_cast<unsigned>(std::min(max_level, 255)),
-                 [&](std::size_t v) { buckets[count[v]].push_back(v); });
-  return buckets;
 }
 
 }  // namespace core

@@ -3,6 +3,7 @@
 // parts are in voxel/test_voxel_units.cpp.
 #include "fdml_localization/core/localization/robust_search.h"
 #include "fdml_localization/core/localization/components.h"
+#include "fdml_localization/core/localization/count_scan.h"
 #include "fdml_localization/core/localization/hypothesis_seeds.h"
 #include "fdml_localization/core/localization/voxel/voxel_engine.h"
 
@@ -164,8 +165,9 @@ TEST(Components, VoxelBucketsMatchAPlainScan)
   }
 }
 
-// The word test of eight counts against a byte-by-byte check, on random words, some with zeros.
-TEST(Components, WordTestOfEightCountsMatchesEachByte)
+// The word tests of eight counts against a byte-by-byte check, on random words and on words
+// holding one value among zeros and 255s.
+TEST(Components, WordTestsOfEightCountsMatchEachByte)
 {
   std::mt19937_64 rng(13);
   for (int trial = 0; trial < 4000; ++trial)
@@ -175,14 +177,22 @@ TEST(Components, WordTestOfEightCountsMatchesEachByte)
     {
       word &= 0xff00ff00ff00ff00ull;  // zeros among random bytes
     }
+    const unsigned value = static_cast<unsigned>(rng() % 256u);
     const unsigned lo = 1u + static_cast<unsigned>(rng() % 128u);
+    bool equal = false;
     bool at_least = false;
     for (int b = 0; b < 8; ++b)
     {
-      at_least = at_least || ((word >> (8 * b)) & 0xffu) >= lo;
+      const unsigned byte = static_cast<unsigned>((word >> (8 * b)) & 0xffu);
+      equal = equal || byte == value;
+      at_least = at_least || byte >= lo;
     }
+    ASSERT_EQ(anyByteEqual(word, value), equal) << std::hex << word << " " << value;
     ASSERT_EQ(anyByteAtLeast(word, lo), at_least) << std::hex << word << " " << lo;
   }
+  EXPECT_TRUE(anyByteEqual(0xff00000000000000ull, 255u));
+  EXPECT_FALSE(anyByteEqual(0xffffffffffffff01ull, 0u));
+  EXPECT_TRUE(anyByteEqual(0x0100000000000000ull, 1u));
 }
 
 TEST(HypothesisSeeds, MaximalSetsMatchBruteForce)

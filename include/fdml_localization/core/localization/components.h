@@ -79,6 +79,18 @@ std::vector<VoxelCluster> regionalPlateaus(const GridSpec& spec, const std::vect
                                            const std::vector<std::size_t>& candidates);
 
 /**
+ * @brief The voxels at exactly @p level outside its regional maxima (regionalMaxima()): those
+ *        connected, through voxels at the level, to a voxel above it, in flood order. @p above
+ *        must list every voxel above the level with a neighbour at it (others do no harm).
+ */
+std::vector<std::size_t> nonMaximalPlateaus(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
+                                            const std::vector<std::size_t>& above);
+
+/// The voxels of @p voxels (same order) with a neighbour whose count is below @p level.
+std::vector<std::size_t> withNeighbourBelow(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
+                                            const std::vector<std::size_t>& voxels);
+
+/**
  * @brief The regional maxima of the count field at exactly @p level: connected plateaus of
  *        voxels with count == level none of whose neighbours has a higher count. Every count
  *        peak of a component becomes its own cluster (peaks are never merged into one centroid).
@@ -86,16 +98,6 @@ std::vector<VoxelCluster> regionalPlateaus(const GridSpec& spec, const std::vect
  */
 std::vector<VoxelCluster> regionalMaxima(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
                                          const std::vector<std::size_t>& candidates);
-
-/// Whether any of the 8 bytes of @p word is at least @p lo (1 <= lo <= 128): a byte above
-/// lo - 1 carries into its top bit (no carry crosses a byte below 128), and a byte of 128 or
-/// more already has it. Eight counts tested at once.
-bool anyByteAtLeast(std::uint64_t word, unsigned lo);
-
-/// The voxels of each count value: result[c] lists the voxels (ascending) with count c, for
-/// max(min_level, 1) <= c <= max_level.
-std::vector<std::vector<std::size_t>> voxelsByCount(const std::vector<std::uint8_t>& count, int min_level,
-                                                    int max_level);
 
 }  // namespace core
 }  // namespace fdml_localization

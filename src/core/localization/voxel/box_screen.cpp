@@ -2,6 +2,7 @@
 
 #include "fdml_localization/core/localization/adaptive/leaf_clustering.h"
 #include "fdml_localization/core/localization/components.h"
+#include "fdml_localization/core/localization/count_scan.h"
 
 #include <algorithm>
 #include <cstring>
@@ -13,8 +14,7 @@ namespace core
 {
 namespace
 {
-/// Voxels along each side of the coarsest blocks tested.
-constexpr int kTopBlock = 8;
+constexpr int kTopBlock = BlockMaxima::kSide;
 
 /// A block of voxels: [x0, x1) x [y0, y1) x [t0, t1) in cells.
 struct Block
@@ -27,33 +27,36 @@ struct Block
   }
 };
 
-/// Members: the voxels whose count reaches a level.
+/// Members: the voxels whose count lies in [lo, hi] (hi 255: reaches lo; hi == lo: equals it).
 class CountMembers
 {
 public:
-  CountMembers(const std::vector<std::uint8_t>& count, const GridSpec& spec, int level)
-    : count_(count), spec_(spec), level_(level)
+  CountMembers(const std::vector<std::uint8_t>& count, const GridSpec& spec, int lo, int hi)
+    : count_(count), spec_(spec), lo_(lo), hi_(hi)
   {}
 
   bool has(int x, int y, int t) const
   {
-    return count_[spec_.index(x, y, t)] >= level_;
+    const int c = count_[spec_.index(x, y, t)];
+    return c >= lo_ && c <= hi_;
   }
 
   /// Whether voxels [x0, x1) of row (y, t) hold a member; 8 at a time by a word test of their
-  /// bytes (anyByteAtLeast(), levels 1 to 128).
+  /// bytes (anyByteAtLeast() or anyByteEqual(), levels 1 to 128).
   bool anyInRow(int x0, int x1, int y, int t) const
   {
     const std::size_t row = spec_.index(0, y, t);
-    if (x1 - x0 == 8 && level_ >= 1 && level_ <= 128)
+    if (x1 - x0 == 8 && lo_ >= 1 && lo_ <= 128 && (hi_ >= 255 || hi_ == lo_))
     {
       std::uint64_t word = 0;
       std::memcpy(&word, count_.data() + row + static_cast<std::size_t>(x0), 8);
-      return anyByteAtLeast(word, static_cast<unsigned>(level_));
+      const unsigned lo = static_cast<unsigned>(lo_);
+      return hi_ >= 255 ? anyByteAtLeast(word, lo) : anyByteEqual(word, lo);
     }
     for (int x = x0; x < x1; ++x)
     {
-      if (count_[row + static_cast<std::size_t>(x)] >= level_)
+      const int c = count_[row + static_cast<std::size_t>(x)];
+      if (c >= lo_ && c <= hi_)
       {
         return true;
       }
@@ -64,40 +67,8 @@ public:
 private:
   const std::vector<std::uint8_t>& count_;
   const GridSpec& spec_;
-  int level_;
-};
-
-/// Members: the voxels of a set.
-class SetMembers
-{
-public:
-  explicit SetMembers(const VoxelSet& set) : set_(set)
-  {}
-
-  bool has(int x, int y, int t) const
-  {
-    return set_.test(x, y, t);
-  }
-
-  bool anyInRow(int x0, int x1, int y, int t) const
-  {
-    const std::uint64_t* row = set_.row(y, t);
-    for (int x = x0; x < x1;)
-    {
-      const int end = std::min(x1, (x & ~63) + 64);  // within one word
-      const std::uint64_t bits = row[x >> 6] >> (x & 63);
-      const int n = end - x;
-      if ((n == 64 ? bits : bits & ((std::uint64_t(1) << n) - 1)) != 0)
-      {
-        return true;
-      }
-      x = end;
-    }
-    return false;
-  }
-
-private:
-  const VoxelSet& set_;
+  int lo_;
+  int hi_;
 };
 
 /// Depth-first over a block's halves, down to voxels, of the members' verdicts.
@@ -219,43 +190,20 @@ Block topBlockOf(const GridSpec& spec, int ix, int iy, int it)
                 t, std::min(t + kTopBlock, spec.nt) };
 }
 
-/// The top blocks holding @p voxels, in index order of their first voxel.
-std::vector<Block> topBlocksOf(const GridSpec& spec, const std::vector<std::size_t>& voxels)
+/// The top blocks @p blocks reaching @p level.
+std::vector<Block> topBlocks(const GridSpec& spec, const BlockMaxima& blocks, int level)
 {
-  std::vector<std::size_t> starts;
-  for (std::size_t v : voxels)
+  std::vector<Block> out;
+  const std::size_t bx = static_cast<std::size_t>(blocks.blocksX());
+  const std::size_t by = static_cast<std::size_t>(blocks.blocksY());
+  for (std::size_t b : blocks.reaching(level))
   {
-    int ix = 0, iy = 0, it = 0;
-    spec.unindex(v, ix, iy, it);
-    const Block b = topBlockOf(spec, ix, iy, it);
-    starts.push_back(spec.index(b.x0, b.y0, b.t0));
+    const int x = static_cast<int>(b % bx) * kTopBlock;
+    const int y = static_cast<int>((b / bx) % by) * kTopBlock;
+    const int t = static_cast<int>(b / (bx * by)) * kTopBlock;
+    out.push_back(topBlockOf(spec, x, y, t));
   }
-  std::sort(starts.begin(), starts.end());
-  starts.erase(std::unique(starts.begin(), starts.end()), starts.end());
-  std::vector<Block> blocks;
-  for (std::size_t s : starts)
-  {
-    int ix = 0, iy = 0, it = 0;
-    spec.unindex(s, ix, iy, it);
-    blocks.push_back(topBlockOf(spec, ix, iy, it));
-  }
-  return blocks;
-}
-
-std::vector<Block> topBlocks(const GridSpec& spec)
-{
-  std::vector<Block> blocks;
-  for (int t = 0; t < spec.nt; t += kTopBlock)
-  {
-    for (int y = 0; y < spec.ny; y += kTopBlock)
-    {
-      for (int x = 0; x < spec.nx; x += kTopBlock)
-      {
-        blocks.push_back(topBlockOf(spec, x, y, t));
-      }
-    }
-  }
-  return blocks;
+  return out;
 }
 
 /// The verdicts (ascending voxel) on @p members, block by block.
@@ -284,19 +232,66 @@ std::vector<VoxelVerdict> screenMembers(const GridSpec& spec, const std::vector<
 }
 }  // namespace
 
-std::vector<VoxelVerdict> screenVoxels(const GridSpec& spec, const VoxelSet& members,
-                                       const std::vector<std::size_t>& voxels, int needed, const BoxScreen& screen)
+BlockMaxima::BlockMaxima(const GridSpec& spec, const std::vector<std::uint8_t>& count)
+  : bx_((spec.nx + kSide - 1) / kSide)
+  , by_((spec.ny + kSide - 1) / kSide)
+  , bt_((spec.nt + kSide - 1) / kSide)
+  , max_(static_cast<std::size_t>(bx_) * by_ * bt_, 0)
 {
-  return screenMembers(spec, topBlocksOf(spec, voxels), SetMembers(members), needed, true, screen);
+  // Per block row: the rows' element-wise maximum (vectorised), then each block's 8 columns.
+  std::vector<std::uint8_t> columns(static_cast<std::size_t>(bx_) * kSide, 0);
+  for (int bt = 0; bt < bt_; ++bt)
+  {
+    for (int by = 0; by < by_; ++by)
+    {
+      std::fill(columns.begin(), columns.end(), 0);
+      for (int t = bt * kSide; t < std::min(spec.nt, (bt + 1) * kSide); ++t)
+      {
+        for (int y = by * kSide; y < std::min(spec.ny, (by + 1) * kSide); ++y)
+        {
+          const std::uint8_t* row = count.data() + spec.index(0, y, t);
+          for (int x = 0; x < spec.nx; ++x)
+          {
+            columns[x] = std::max(columns[x], row[x]);
+          }
+        }
+      }
+      std::uint8_t* out = max_.data() + (static_cast<std::size_t>(bt) * by_ + by) * bx_;
+      for (int b = 0; b < bx_; ++b)
+      {
+        out[b] = *std::max_element(columns.begin() + b * kSide, columns.begin() + (b + 1) * kSide);
+      }
+    }
+  }
+}
+
+std::vector<std::size_t> BlockMaxima::reaching(int level) const
+{
+  std::vector<std::size_t> blocks;
+  for (std::size_t b = 0; b < max_.size(); ++b)
+  {
+    if (max_[b] >= level)
+    {
+      blocks.push_back(b);
+    }
+  }
+  return blocks;
+}
+
+std::vector<VoxelVerdict> screenLevel(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
+                                      const BlockMaxima& blocks, const BoxScreen& screen)
+{
+  return screenMembers(spec, topBlocks(spec, blocks, level), CountMembers(count, spec, level, level), level, true,
+                       screen);
 }
 
 std::vector<LeafBox> reachingLeaves(const GridSpec& spec, const std::vector<std::uint8_t>& count, int target,
-                                    const BoxScreen& screen)
+                                    const BlockMaxima& blocks, const BoxScreen& screen)
 {
   const int needed = std::clamp(target, 0, 255);
   std::vector<LeafBox> leaves;
-  for (const VoxelVerdict& v :
-       screenMembers(spec, topBlocks(spec), CountMembers(count, spec, needed), needed, false, screen))
+  for (const VoxelVerdict& v : screenMembers(spec, topBlocks(spec, blocks, needed),
+                                             CountMembers(count, spec, needed, 255), needed, false, screen))
   {
     leaves.push_back(voxelLeaf(spec, v.voxel, std::min<int>(count[v.voxel], v.bound)));
   }

@@ -1,7 +1,8 @@
 #include "fdml_localization/core/localization/voxel/count_buckets.h"
 
+#include "fdml_localization/core/localization/count_scan.h"
+
 #include <algorithm>
-#include <iterator>
 
 namespace fdml_localization
 {
@@ -29,51 +30,38 @@ const std::vector<std::size_t>& CountBuckets::at(int level)
   return buckets_[level];
 }
 
-ScreenedCount::ScreenedCount(const GridSpec& spec, const std::vector<std::uint8_t>& count, int lowest, int k)
-  : spec_(spec)
-  , count_(count)
-  , buckets_(count, lowest, k)
-  , lowered_(static_cast<std::size_t>(std::max(k, 0)) + 1)
-  , members_(spec)
+ScreenedCount::ScreenedCount(const GridSpec& spec, const std::vector<std::uint8_t>& count, const BlockMaxima& blocks)
+  : spec_(spec), count_(count), blocks_(blocks)
 {}
-
-std::vector<std::size_t> ScreenedCount::voxelsAt(int level)
-{
-  const std::vector<std::size_t>& original = buckets_.at(level);
-  std::vector<std::size_t>& lowered = lowered_[level];
-  if (lowered.empty())
-  {
-    return original;
-  }
-  std::sort(lowered.begin(), lowered.end());
-  std::vector<std::size_t> voxels;
-  voxels.reserve(original.size() + lowered.size());
-  std::merge(original.begin(), original.end(), lowered.begin(), lowered.end(), std::back_inserter(voxels));
-  lowered.clear();
-  lowered.shrink_to_fit();
-  return voxels;
-}
 
 std::vector<VoxelCluster> ScreenedCount::maximaAt(int level, const BoxScreen& screen)
 {
-  if (level < 1 || level >= static_cast<int>(lowered_.size()))
+  if (level < 1 || level > 255)
   {
     return {};
   }
-  members_.clear();
-  std::vector<std::size_t> voxels;
-  for (const VoxelCluster& plateau : regionalPlateaus(spec_, count_, level, voxelsAt(level)))
+  if (level != next_level_)
   {
-    for (std::size_t v : plateau.voxels)
+    // The first level asked for (or one below a level skipped): every voxel above it.
+    above_.clear();
+    for (std::size_t v = 0; v < count_.size(); ++v)
     {
-      int ix = 0, iy = 0, it = 0;
-      spec_.unindex(v, ix, iy, it);
-      members_.set(ix, iy, it);
-      voxels.push_back(v);
+      if (count_[v] > level)
+      {
+        above_.push_back(v);
+      }
     }
   }
+  next_level_ = level - 1;
+  // The plateaus touching a voxel above the level are no maxima: lifted above it while the level
+  // is screened (so they are not), then put back. (None at level 255: no count is above it.)
+  const std::vector<std::size_t> lower = nonMaximalPlateaus(spec_, count_, level, above_);
+  for (std::size_t v : lower)
+  {
+    count_[v] = static_cast<std::uint8_t>(level + 1);
+  }
   std::vector<std::size_t> kept;
-  for (const VoxelVerdict& v : screenVoxels(spec_, members_, voxels, level, screen))
+  for (const VoxelVerdict& v : screenLevel(spec_, count_, level, blocks_, screen))
   {
     if (v.bound >= level)
     {
@@ -82,9 +70,15 @@ std::vector<VoxelCluster> ScreenedCount::maximaAt(int level, const BoxScreen& sc
     }
     // No pose of the voxel explains `level` readings: at most level - 1.
     count_[v.voxel] = static_cast<std::uint8_t>(level - 1);
-    lowered_[level - 1].push_back(v.voxel);
   }
-  // The voxels kept are those of the maxima (their neighbours at the level are theirs too).
+  for (std::size_t v : lower)
+  {
+    count_[v] = static_cast<std::uint8_t>(level);
+  }
+  // The voxels left at the level never change again; those that may touch a lower one stay.
+  above_.insert(above_.end(), kept.begin(), kept.end());
+  above_.insert(above_.end(), lower.begin(), lower.end());
+  above_ = withNeighbourBelow(spec_, count_, level, above_);
   return regionalMaxima(spec_, count_, level, kept);
 }
 

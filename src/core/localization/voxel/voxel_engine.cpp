@@ -61,7 +61,12 @@ void writeWordCounts(const std::vector<const std::uint64_t*>& rows, int w, std::
       used = std::max(used, b + 1);
     }
   }
-  for (int j = 0; used > 0 && 8 * j < n; ++j)
+  if (used == 0)
+  {
+    std::memset(out, 0, static_cast<std::size_t>(n));
+    return;
+  }
+  for (int j = 0; 8 * j < n; ++j)
   {
     std::uint64_t eight = 0;
     for (int b = 0; b < used; ++b)
@@ -240,11 +245,12 @@ std::vector<VoxelSet> VoxelEngine::paperPreimages(const std::vector<Reading>& re
 
 void VoxelEngine::countField(const std::vector<VoxelSet>& sets, std::vector<std::uint8_t>& count) const
 {
-  count.assign(spec_.voxelCount(), 0);
   if (sets.empty())
   {
+    count.assign(spec_.voxelCount(), 0);
     return;
   }
+  count.resize(spec_.voxelCount());  // every voxel is written below
   const int nx = spec_.nx;
   const int ny = spec_.ny;
   const int nt = spec_.nt;

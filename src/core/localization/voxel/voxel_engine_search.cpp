@@ -43,14 +43,15 @@ constexpr std::size_t kLargePlateau = 16;
 class VoxelSeeds : public SeedSource
 {
 public:
-  VoxelSeeds(const VoxelEngine& engine, const BoxScreen& screen, double gate, int lowest, int k, StageTimes& times)
+  VoxelSeeds(const VoxelEngine& engine, const BoxScreen& screen, const BlockMaxima& blocks, double gate, int lowest,
+             int k, StageTimes& times)
     : engine_(engine)
     , map_(screen.map)
     , readings_(screen.readings)
     , screen_(screen)
     , gate_(gate)
     , times_(times)
-    , conservative_(engine.grid(), engine.lastCount(), lowest, k)
+    , conservative_(engine.grid(), engine.lastCount(), blocks)
     , buckets_(engine.lastSeedCount(), lowest, k)
     , raw_buckets_(engine.lastRawCount(), lowest, k)
   {}
@@ -191,8 +192,10 @@ void VoxelEngine::localizeRobust(const std::vector<Reading>& readings, Result& r
   const int lowest = options_.min_inliers > 0 ? options_.min_inliers : 3;
   const BoxScreen screen{ *map_, readings, std::max(options_.range_tolerance, options_.agreement_tolerance),
                           threads() };
-  VoxelSeeds seeds(*this, screen, seedGate(readings, options_, SeedScale{ spec_.cell, spec_.thetaStep() }), lowest, k,
-                   result.times);
+  // The conservative count's top blocks (the screens skip those below their level).
+  const BlockMaxima blocks(spec_, count_);
+  VoxelSeeds seeds(*this, screen, blocks, seedGate(readings, options_, SeedScale{ spec_.cell, spec_.thetaStep() }),
+                   lowest, k, result.times);
   SeedSearchOutcome found =
       robustSearch(seeds, *map_, readings, options_, SeedScale{ spec_.cell, spec_.thetaStep() }, result.times);
   result.min_inliers_used = found.min_inliers_used;
@@ -213,8 +216,8 @@ void VoxelEngine::localizeRobust(const std::vector<Reading>& readings, Result& r
     const int target = netConsensus(result.candidates.front());
     // The box test bounds a voxel's consensus tighter than the count's distance bounds (and it
     // stops early where the target is out of reach): only the voxels passing become leaves.
-    const std::vector<LeafBox> leaves =
-        reachingLeaves(spec_, count_, target, BoxScreen{ *map_, readings, options_.range_tolerance, threads() });
+    const std::vector<LeafBox> leaves = reachingLeaves(
+        spec_, count_, target, blocks, BoxScreen{ *map_, readings, options_.range_tolerance, threads() });
     const RefinementSettings settings = latticeRefinement(options_, spec_.cell, spec_.thetaStep());
     fillUncoveredRegions(*map_, leaves, spec_.nt, readings, options_, settings, result);
     settleInNearBasins(*map_, readings, options_, settings, result.candidates);

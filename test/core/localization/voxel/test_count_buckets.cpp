@@ -93,6 +93,39 @@ VoxelSets asSets(const std::vector<VoxelCluster>& clusters)
   return sets;
 }
 
+/// nonMaximalPlateaus() at @p level is the rest of the level (@p at_level) off its maxima
+/// (@p maxima), found from the voxels above it touching one at or below it (withNeighbourBelow()).
+void expectOffMaximaFound(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
+                          const std::vector<std::size_t>& at_level, const VoxelSets& maxima)
+{
+  std::set<std::size_t> off_maxima(at_level.begin(), at_level.end());
+  for (const std::vector<std::size_t>& plateau : maxima)
+  {
+    for (std::size_t v : plateau)
+    {
+      off_maxima.erase(v);
+    }
+  }
+  std::vector<std::size_t> above;
+  std::vector<std::size_t> touching;
+  for (std::size_t v = 0; v < count.size(); ++v)
+  {
+    const std::vector<std::size_t> next = neighboursOf(spec, v);
+    if (count[v] > level)
+    {
+      above.push_back(v);
+      if (std::any_of(next.begin(), next.end(), [&](std::size_t w) { return count[w] <= level; }))
+      {
+        touching.push_back(v);
+      }
+    }
+  }
+  ASSERT_EQ(withNeighbourBelow(spec, count, level + 1, above), touching);
+  std::vector<std::size_t> lower = nonMaximalPlateaus(spec, count, level, touching);
+  std::sort(lower.begin(), lower.end());
+  EXPECT_EQ(lower, std::vector<std::size_t>(off_maxima.begin(), off_maxima.end())) << "level " << level;
+}
+
 TEST(CountBuckets, RegionalMaximaOfRandomFieldsMatchABruteForce)
 {
   const GridSpec spec = test::smallSpec(14, 9, 8);
@@ -128,6 +161,7 @@ TEST(CountBuckets, RegionalMaximaOfRandomFieldsMatchABruteForce)
       ASSERT_EQ(buckets.at(level), plain);
       const VoxelSets expected = bruteMaxima(spec, count, level);
       EXPECT_EQ(asSets(regionalMaxima(spec, count, level, plain)), expected) << "trial " << trial;
+      expectOffMaximaFound(spec, count, level, plain, expected);
       found += expected.size();
     }
     EXPECT_TRUE(buckets.at(0).empty());
@@ -145,7 +179,8 @@ TEST(CountBuckets, TheScreenedFieldsMaximaPassTheBoxTestAndItStaysAnUpperBound)
     const GridSpec& spec = run.engine->grid();
     const std::vector<std::uint8_t>& count = run.engine->lastCount();
     const double tolerance = std::max(run.options.range_tolerance, run.options.agreement_tolerance);
-    ScreenedCount screened(spec, count, 3, 10);
+    const BlockMaxima blocks(spec, count);
+    ScreenedCount screened(spec, count, blocks);
     BoxConsensusTest test(*run.map, run.readings, tolerance);
     for (int level = 10; level >= 3; --level)
     {
@@ -179,6 +214,40 @@ TEST(CountBuckets, TheScreenedFieldsMaximaPassTheBoxTestAndItStaysAnUpperBound)
   }
   EXPECT_GT(lowered_total, 100u);
   EXPECT_GT(returned_total, 0u);
+}
+
+TEST(CountBuckets, LevelsSkippedLeaveTheScreenedFieldsMaximaRight)
+{
+  const CorruptedLRoomRun run(5);
+  const GridSpec& spec = run.engine->grid();
+  const double tolerance = std::max(run.options.range_tolerance, run.options.agreement_tolerance);
+  const BlockMaxima blocks(spec, run.engine->lastCount());
+  ScreenedCount screened(spec, run.engine->lastCount(), blocks);
+  std::size_t returned = 0;
+  std::size_t lowered = 0;
+  for (int level : { 9, 7, 6, 4 })
+  {
+    // Only the voxels of the level's maxima are screened: a voxel lowered was in one.
+    const std::vector<std::uint8_t> before = screened.values();
+    std::set<std::size_t> on_maxima;
+    for (const std::vector<std::size_t>& plateau : bruteMaxima(spec, before, level))
+    {
+      on_maxima.insert(plateau.begin(), plateau.end());
+    }
+    const VoxelSets maxima = asSets(screened.maximaAt(level, BoxScreen{ *run.map, run.readings, tolerance, 2 }));
+    EXPECT_EQ(maxima, bruteMaxima(spec, screened.values(), level)) << "level " << level;
+    for (std::size_t v = 0; v < before.size(); ++v)
+    {
+      if (screened.values()[v] != before[v])
+      {
+        ++lowered;
+        ASSERT_EQ(on_maxima.count(v), 1u) << "level " << level << " voxel " << v;
+      }
+    }
+    returned += maxima.size();
+  }
+  EXPECT_GT(returned, 0u);
+  EXPECT_GT(lowered, 0u);
 }
 
 }  // namespace

@@ -29,6 +29,39 @@ struct BoxScreen
   int threads = 1;
 };
 
+/**
+ * @brief The largest count in each top block (8 x 8 x 8 voxels, the coarsest a screen tests) of
+ *        a count field, so that a screen visits only the blocks that may hold a voxel of its
+ *        level. Still a bound of the field when it is lowered afterwards (ScreenedCount).
+ */
+class BlockMaxima
+{
+public:
+  /// Voxels along each side of a top block.
+  static constexpr int kSide = 8;
+
+  BlockMaxima(const GridSpec& spec, const std::vector<std::uint8_t>& count);
+
+  /// The top blocks (index (bt * by + byi) * bx + bxi, ascending) whose largest count is at
+  /// least @p level.
+  std::vector<std::size_t> reaching(int level) const;
+
+  int blocksX() const
+  {
+    return bx_;
+  }
+  int blocksY() const
+  {
+    return by_;
+  }
+
+private:
+  int bx_ = 0;
+  int by_ = 0;
+  int bt_ = 0;
+  std::vector<std::uint8_t> max_;  ///< by top block
+};
+
 /// A voxel's verdict: a sound bound of the readings a pose of it explains, the box test's
 /// (BoxConsensusTest::bound()) when it passes (reaches the readings needed), else the readings
 /// needed - 1 (its box, or a block holding it, was ruled out).
@@ -39,22 +72,22 @@ struct VoxelVerdict
 };
 
 /**
- * @brief The verdicts (ascending voxel) on the voxels of @p members (listed in @p voxels, any
- *        order): whether each one's box may explain @p needed readings. A voxel fails with a
- *        block holding it whose box cannot explain them (no pose in it can: the box test is
- *        sound, though not monotone, so a voxel's own box can pass where a block's failed), or
- *        by its own box.
+ * @brief The verdicts (ascending voxel) on every voxel v with @p count[v] == @p level: whether
+ *        its box may explain @p level readings (@p blocks: BlockMaxima of @p count or of a field
+ *        above it). A voxel fails with a block holding it whose box
+ *        cannot explain them (no pose in it can: the box test is sound, though not monotone, so
+ *        a voxel's own box can pass where a block's failed), or by its own box.
  */
-std::vector<VoxelVerdict> screenVoxels(const GridSpec& spec, const VoxelSet& members,
-                                       const std::vector<std::size_t>& voxels, int needed, const BoxScreen& screen);
+std::vector<VoxelVerdict> screenLevel(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
+                                      const BlockMaxima& blocks, const BoxScreen& screen);
 
 /**
  * @brief The voxels v of @p spec with @p count[v] >= @p target that pass the box test at
- *        @p target readings as screenVoxels() tests them, as leaves (voxelLeaf(), ascending v) counting min(count[v],
+ *        @p target readings as screenLevel() tests them, as leaves (voxelLeaf(), ascending v) counting min(count[v],
  * the box test's bound).
  */
 std::vector<LeafBox> reachingLeaves(const GridSpec& spec, const std::vector<std::uint8_t>& count, int target,
-                                    const BoxScreen& screen);
+                                    const BlockMaxima& blocks, const BoxScreen& screen);
 
 }  // namespace core
 }  // namespace fdml_localization

@@ -41,19 +41,20 @@ private:
 /**
  * @brief The conservative count field (an upper bound of the readings any pose of a voxel
  *        explains) tightened by the box test (BoxConsensusTest) where the seeds come from: when
- *        a level is asked for, the voxels of its regional maxima are screened (screenVoxels()),
+ *        a level is asked for, the voxels of its regional maxima are screened (screenLevel()),
  *        those whose box (or a block holding them) cannot explain that many readings lowered by
- *        one (the field stays an upper bound; they join the plateaus of the level below, where
- *        they are screened again), and the regional maxima of what is left returned. The
- *        count's own maxima are mostly places no pose explains their level (over 99 % where
- *        obstacles corrupt a third of the readings), each of which would cost a seed's
- *        verification. Levels must be asked for from the highest down, each once.
+ *        one (the field stays an upper bound; they are screened again at the level below), and
+ *        the regional maxima of what is left returned. The count's own maxima are mostly places
+ *        no pose explains their level (over 99 % where obstacles corrupt a third of the
+ *        readings), each of which would cost a seed's verification. Levels are asked for from
+ *        the highest down; one below a level skipped costs a scan of the field.
  */
 class ScreenedCount
 {
 public:
-  /// @p spec and @p count (the conservative field, copied) must outlive this.
-  ScreenedCount(const GridSpec& spec, const std::vector<std::uint8_t>& count, int lowest, int k);
+  /// @p spec and @p blocks (BlockMaxima of @p count) must outlive this; @p count (the
+  /// conservative field) is copied.
+  ScreenedCount(const GridSpec& spec, const std::vector<std::uint8_t>& count, const BlockMaxima& blocks);
 
   /// Screens the voxels of the regional maxima at @p level (box test at @p screen's tolerance:
   /// the larger of the count's tau and the verification's agreement eps, so a voxel lowered
@@ -68,14 +69,13 @@ public:
   }
 
 private:
-  /// The voxels whose screened count is @p level (ascending), 1 <= @p level <= k.
-  std::vector<std::size_t> voxelsAt(int level);
-
   const GridSpec& spec_;
-  std::vector<std::uint8_t> count_;                ///< the screened field (copy of the conservative one)
-  CountBuckets buckets_;                           ///< of the conservative field (unscreened)
-  std::vector<std::vector<std::size_t>> lowered_;  ///< by level: voxels lowered to it
-  VoxelSet members_;                               ///< the voxels being screened
+  std::vector<std::uint8_t> count_;  ///< the screened field (copy of the conservative one)
+  const BlockMaxima& blocks_;        ///< of the conservative field
+  /// The voxels above the next level that may touch a voxel at it (the rest are surrounded by
+  /// voxels at least as high, which never change again).
+  std::vector<std::size_t> above_;
+  int next_level_ = -1;  ///< the level maximaAt() expects next (above_ is for it)
 };
 
 }  // namespace core

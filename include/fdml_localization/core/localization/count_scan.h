@@ -1,0 +1,31 @@
+/**
+ * @file count_scan.h
+ * @brief Scans of a count field (one byte per voxel, GridSpec::index order) eight voxels at a
+ *        time: word tests of eight counts, and the voxels of each count.
+ */
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace fdml_localization
+{
+namespace core
+{
+/// Whether any of the 8 bytes of @p word is at least @p lo (1 <= lo <= 128): a byte above
+/// lo - 1 carries into its top bit (no carry crosses a byte below 128), and a byte of 128 or
+/// more already has it. Eight counts tested at once.
+bool anyByteAtLeast(std::uint64_t word, unsigned lo);
+
+/// Whether any of the 8 bytes of @p word equals @p value (<= 255): some byte of word ^ value
+/// is zero.
+bool anyByteEqual(std::uint64_t word, unsigned value);
+
+/// The voxels of each count value: result[c] lists the voxels (ascending) with count c, for
+/// max(min_level, 1) <= c <= max_level.
+std::vector<std::vector<std::size_t>> voxelsByCount(const std::vector<std::uint8_t>& count, int min_level,
+                                                    int max_level);
+
+}  // namespace core
+}  // namespace fdml_localization

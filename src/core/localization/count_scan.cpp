@@ -1,0 +1,82 @@
+#include "fdml_localization/core/localization/count_scan.h"
+
+#include <algorithm>
+#include <cstring>
+
+namespace fdml_localization
+{
+namespace core
+{
+bool anyByteAtLeast(std::uint64_t word, unsigned lo)
+{
+  constexpr std::uint64_t kOnes = 0x0101010101010101ull;
+  constexpr std::uint64_t kTops = 0x8080808080808080ull;
+  return (((word + kOnes * (128u - lo)) | word) & kTops) != 0;
+}
+
+bool anyByteEqual(std::uint64_t word, unsigned value)
+{
+  constexpr std::uint64_t kOnes = 0x0101010101010101ull;
+  constexpr std::uint64_t kTops = 0x8080808080808080ull;
+  const std::uint64_t x = word ^ (kOnes * value);
+  return ((x - kOnes) & ~x & kTops) != 0;
+}
+
+namespace
+{
+/// Calls @p fn(v) for every voxel v (ascending) whose count lies in [lo, hi], lo >= 1.
+template <typename Fn>
+void forEachVoxelIn(const std::vector<std::uint8_t>& count, unsigned lo, unsigned hi, Fn&& fn)
+{
+  const std::size_t n = count.size();
+  std::size_t v = 0;
+  if (lo > 255u || lo > hi)
+  {
+    return;
+  }
+  if (lo <= 128u)
+  {
+    // Skip 8 voxels at a time while none reaches lo.
+    for (; v + 8 <= n; v += 8)
+    {
+      std::uint64_t word = 0;
+      std::memcpy(&word, count.data() + v, 8);
+      if (lo == hi ? !anyByteEqual(word, lo) : !anyByteAtLeast(word, lo))
+      {
+        continue;
+      }
+      for (std::size_t j = v; j < v + 8; ++j)
+      {
+        if (count[j] >= lo && count[j] <= hi)
+        {
+          fn(j);
+        }
+      }
+    }
+  }
+  for (; v < n; ++v)
+  {
+    if (count[v] >= lo && count[v] <= hi)
+    {
+      fn(v);
+    }
+  }
+}
+}  // namespace
+
+std::vector<std::vector<std::size_t>> voxelsByCount(const std::vector<std::uint8_t>& count, int min_level,
+                                                    int max_level)
+{
+  std::vector<std::vector<std::size_t>> buckets(static_cast<std::size_t>(std::max(max_level, 0)) + 1);
+  if (max_level < 1)
+  {
+    return buckets;
+  }
+  const auto lo = static_cast<unsigned>(std::clamp(min_level, 1, 256));
+  forEachVoxelIn(count, lo, static_cast<unsigned>(std::min(max_level, 255)),
+                 [&](std::size_t v) { buckets[count[v]].push_back(v); });
+  return buckets;
+}
+
+}  // namespace core
+}  // namespace fdml_localization

@@ -1,5 +1,7 @@
 #include "fdml_localization/core/localization/components.h"
 
+#include "fdml_localization/core/localization/level_runs.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -184,43 +186,13 @@ std::vector<VoxelCluster> connectedComponents(const GridSpec& spec, const std::v
 
 std::size_t componentSize(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level, std::size_t seed)
 {
-  if (seed >= count.size() || count[seed] < level)
-  {
-    return 0;
-  }
-  BitFlags visited(count.size());
-  std::vector<std::size_t> queue;
-  flood(
-      Neighbours(spec), seed, visited, queue, [&](std::size_t u) { return count[u] >= level; }, [](std::size_t) {});
-  return queue.size();
+  return componentSizes(spec, count, level, { seed }).front();
 }
 
 std::vector<std::size_t> componentSizes(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
                                         const std::vector<std::size_t>& seeds)
 {
-  std::vector<std::size_t> sizes(seeds.size(), 0);
-  BitFlags visited(count.size());
-  const Neighbours neighbours(spec);
-  std::vector<std::size_t> queue;
-  for (std::size_t i = 0; i < seeds.size(); ++i)
-  {
-    const std::size_t seed = seeds[i];
-    if (seed >= count.size() || count[seed] < level || visited.test(seed))
-    {
-      continue;
-    }
-    flood(
-        neighbours, seed, visited, queue, [&](std::size_t u) { return count[u] >= level; }, [](std::size_t) {});
-    // Every later seed flooded now lies in this component.
-    for (std::size_t j = i; j < seeds.size(); ++j)
-    {
-      if (sizes[j] == 0 && seeds[j] < count.size() && visited.test(seeds[j]))
-      {
-        sizes[j] = queue.size();
-      }
-    }
-  }
-  return sizes;
+  return LevelRuns(spec, count, level).componentSizes(seeds);
 }
 
 std::vector<VoxelCluster> regionalPlateaus(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,

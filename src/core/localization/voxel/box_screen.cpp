@@ -76,15 +76,16 @@ template <typename Members>
 class BlockSearch
 {
 public:
-  BlockSearch(const GridSpec& spec, const Members& members, int needed, bool with_failed, const BoxScreen& screen)
+  /// @p lowered: where the members failing are set to needed - 1 (none: not recorded).
+  BlockSearch(const GridSpec& spec, const Members& members, int needed, std::uint8_t* lowered, const BoxScreen& screen)
     : spec_(spec)
     , members_(members)
     , needed_(needed)
-    , with_failed_(with_failed)
+    , lowered_(lowered)
     , test_(screen.map, screen.readings, screen.tolerance)
   {}
 
-  /// Appends the verdicts on @p b's members to @p out (failed ones only if asked for).
+  /// Appends the verdicts on @p b's members passing to @p out, and lowers those failing.
   void search(const Block& b, std::vector<VoxelVerdict>& out)
   {
     if (b.unit())
@@ -93,10 +94,14 @@ public:
       {
         const std::size_t v = spec_.index(b.x0, b.y0, b.t0);
         const int bound = test_.bound(voxelBox(spec_, v), needed_);
-        if (bound >= needed_ || with_failed_)
+        if (bound >= needed_)
+        {
+          out.push_back(VoxelVerdict{ v, bound });
+        }
+        else if (lowered_)
         {
           // Below the readings needed the test stops early: its count bounds nothing.
-          out.push_back(VoxelVerdict{ v, bound >= needed_ ? bound : needed_ - 1 });
+          lowered_[v] = static_cast<std::uint8_t>(needed_ - 1);
         }
       }
       return;
@@ -107,7 +112,7 @@ public:
     }
     if (!test_.reaches(blockBox(b), needed_))
     {
-      failAll(b, out);
+      failAll(b);
       return;
     }
     const int xm = (b.x0 + b.x1 + 1) / 2;
@@ -144,10 +149,10 @@ private:
     return false;
   }
 
-  /// Every member of @p b fails, into @p out if failed ones are asked for.
-  void failAll(const Block& b, std::vector<VoxelVerdict>& out) const
+  /// Every member of @p b fails.
+  void failAll(const Block& b) const
   {
-    for (int t = b.t0; t < b.t1 && with_failed_; ++t)
+    for (int t = b.t0; t < b.t1 && lowered_; ++t)
     {
       for (int y = b.y0; y < b.y1; ++y)
       {
@@ -155,7 +160,7 @@ private:
         {
           if (members_.has(x, y, t))
           {
-            out.push_back(VoxelVerdict{ spec_.index(x, y, t), needed_ - 1 });
+            lowered_[spec_.index(x, y, t)] = static_cast<std::uint8_t>(needed_ - 1);
           }
         }
       }
@@ -177,7 +182,7 @@ private:
   const GridSpec& spec_;
   const Members& members_;
   int needed_;
-  bool with_failed_;
+  std::uint8_t* lowered_;
   BoxConsensusTest test_;
 };
 
@@ -206,15 +211,17 @@ std::vector<Block> topBlocks(const GridSpec& spec, const BlockMaxima& blocks, in
   return out;
 }
 
-/// The verdicts (ascending voxel) on @p members, block by block.
+/// The verdicts (ascending voxel) on @p members passing, block by block; those failing are set to
+/// needed - 1 in @p lowered (if any). Threads take distinct top blocks, and a block's search reads
+/// and writes only its own voxels (the word tests of a row read a top block's own 8 voxels).
 template <typename Members>
 std::vector<VoxelVerdict> screenMembers(const GridSpec& spec, const std::vector<Block>& blocks, const Members& members,
-                                        int needed, bool with_failed, const BoxScreen& screen)
+                                        int needed, std::uint8_t* lowered, const BoxScreen& screen)
 {
   std::vector<std::vector<VoxelVerdict>> found(blocks.size());
 #pragma omp parallel num_threads(screen.threads) if (blocks.size() >= 16)
   {
-    BlockSearch<Members> search(spec, members, needed, with_failed, screen);
+    BlockSearch<Members> search(spec, members, needed, lowered, screen);
 #pragma omp for schedule(dynamic, 4)
     for (long b = 0; b < static_cast<long>(blocks.size()); ++b)
     {
@@ -278,11 +285,15 @@ std::vector<std::size_t> BlockMaxima::reaching(int level) const
   return blocks;
 }
 
-std::vector<VoxelVerdict> screenLevel(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
+std::vector<VoxelVerdict> screenLevel(const GridSpec& spec, std::vector<std::uint8_t>& count, int level,
                                       const BlockMaxima& blocks, const BoxScreen& screen)
 {
-  return screenMembers(spec, topBlocks(spec, blocks, level), CountMembers(count, spec, level, level), level, true,
-                       screen);
+  if (level < 1 || level > 255)
+  {
+    return {};
+  }
+  return screenMembers(spec, topBlocks(spec, blocks, level), CountMembers(count, spec, level, level), level,
+                       count.data(), screen);
 }
 
 std::vector<LeafBox> reachingLeaves(const GridSpec& spec, const std::vector<std::uint8_t>& count, int target,
@@ -291,7 +302,7 @@ std::vector<LeafBox> reachingLeaves(const GridSpec& spec, const std::vector<std:
   const int needed = std::clamp(target, 0, 255);
   std::vector<LeafBox> leaves;
   for (const VoxelVerdict& v : screenMembers(spec, topBlocks(spec, blocks, needed),
-                                             CountMembers(count, spec, needed, 255), needed, false, screen))
+                                             CountMembers(count, spec, needed, 255), needed, nullptr, screen))
   {
     leaves.push_back(voxelLeaf(spec, v.voxel, std::min<int>(count[v.voxel], v.bound)));
   }

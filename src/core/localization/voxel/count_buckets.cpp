@@ -60,16 +60,11 @@ std::vector<VoxelCluster> ScreenedCount::maximaAt(int level, const BoxScreen& sc
   {
     count_[v] = static_cast<std::uint8_t>(level + 1);
   }
+  // The voxels failing are lowered to level - 1: no pose of them explains `level` readings.
   std::vector<std::size_t> kept;
   for (const VoxelVerdict& v : screenLevel(spec_, count_, level, blocks_, screen))
   {
-    if (v.bound >= level)
-    {
-      kept.push_back(v.voxel);
-      continue;
-    }
-    // No pose of the voxel explains `level` readings: at most level - 1.
-    count_[v.voxel] = static_cast<std::uint8_t>(level - 1);
+    kept.push_back(v.voxel);
   }
   for (std::size_t v : lower)
   {

@@ -126,33 +126,33 @@ TEST(BoxScreen, EveryVoxelOfALevelGetsASoundVerdict)
   std::size_t failed = 0;
   for (int level = 9; level >= 4; --level)
   {
-    std::vector<std::size_t> at_level;
+    std::vector<std::uint8_t> screened = count;
+    const std::vector<VoxelVerdict> verdicts =
+        screenLevel(spec, screened, level, BlockMaxima(spec, count), BoxScreen{ *run.map, run.readings, 0.05, 2 });
+    BoxConsensusTest each(*run.map, run.readings, 0.05);
+    std::size_t j = 0;
     for (std::size_t v = 0; v < count.size(); ++v)
     {
-      if (count[v] == level)
+      if (count[v] != level)
       {
-        at_level.push_back(v);
+        ASSERT_EQ(screened[v], count[v]) << "voxel " << v << " is off the level";
+        continue;
       }
-    }
-    const std::vector<VoxelVerdict> verdicts =
-        screenLevel(spec, count, level, BlockMaxima(spec, count), BoxScreen{ *run.map, run.readings, 0.05, 2 });
-    ASSERT_EQ(verdicts.size(), at_level.size()) << "level " << level;
-    BoxConsensusTest each(*run.map, run.readings, 0.05);
-    for (std::size_t j = 0; j < verdicts.size(); ++j)
-    {
-      ASSERT_EQ(verdicts[j].voxel, at_level[j]);
-      // A voxel passes by its own box test; one a block ruled out explains fewer readings.
-      const PoseBox box = voxelBox(spec, at_level[j]);
-      const bool own = each.reaches(box, level);
-      const bool passes = verdicts[j].bound >= level;
-      EXPECT_TRUE(!passes || own) << "level " << level << " voxel " << at_level[j];
-      if (!passes)
+      // A voxel passes (in order) by its own box test; one lowered explains fewer readings.
+      const PoseBox box = voxelBox(spec, v);
+      if (j < verdicts.size() && verdicts[j].voxel == v)
       {
-        EXPECT_LE(test::sampledConsensus(*run.map, run.readings, box, 0.05), std::max(verdicts[j].bound, 0))
-            << "voxel " << at_level[j];
+        EXPECT_TRUE(each.reaches(box, level)) << "level " << level << " voxel " << v;
+        EXPECT_EQ(verdicts[j++].bound, each.bound(box, level));
+        ASSERT_EQ(screened[v], level);
+        ++passed;
+        continue;
       }
-      (passes ? passed : failed) += 1;
+      ASSERT_EQ(screened[v], level - 1) << "voxel " << v << " neither passed nor lowered";
+      EXPECT_LT(test::sampledConsensus(*run.map, run.readings, box, 0.05), level) << "voxel " << v;
+      ++failed;
     }
+    EXPECT_EQ(j, verdicts.size()) << "level " << level;
   }
   EXPECT_GT(passed, 50u);
   EXPECT_GT(failed, 50u);

@@ -62,9 +62,8 @@ private:
   std::vector<std::uint8_t> max_;  ///< by top block
 };
 
-/// A voxel's verdict: a sound bound of the readings a pose of it explains, the box test's
-/// (BoxConsensusTest::bound()) when it passes (reaches the readings needed), else the readings
-/// needed - 1 (its box, or a block holding it, was ruled out).
+/// A voxel passing the box test, with the test's bound (BoxConsensusTest::bound(): a sound bound
+/// of the readings a pose of it explains).
 struct VoxelVerdict
 {
   std::size_t voxel = 0;
@@ -72,19 +71,20 @@ struct VoxelVerdict
 };
 
 /**
- * @brief The verdicts (ascending voxel) on every voxel v with @p count[v] == @p level: whether
- *        its box may explain @p level readings (@p blocks: BlockMaxima of @p count or of a field
- *        above it). A voxel fails with a block holding it whose box
- *        cannot explain them (no pose in it can: the box test is sound, though not monotone, so
- *        a voxel's own box can pass where a block's failed), or by its own box.
+ * @brief Screens every voxel v with @p count[v] == @p level (1 to 255): whether its box may
+ *        explain @p level readings (@p blocks: BlockMaxima of @p count or of a field above it).
+ *        A voxel fails with a block holding it whose box cannot explain them (no pose in it can:
+ *        the box test is sound, though not monotone, so a voxel's own box can pass where a
+ *        block's failed), or by its own box; it is then lowered to level - 1 in @p count.
+ * @return the voxels passing (ascending voxel)
  */
-std::vector<VoxelVerdict> screenLevel(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
+std::vector<VoxelVerdict> screenLevel(const GridSpec& spec, std::vector<std::uint8_t>& count, int level,
                                       const BlockMaxima& blocks, const BoxScreen& screen);
 
 /**
  * @brief The voxels v of @p spec with @p count[v] >= @p target that pass the box test at
- *        @p target readings as screenLevel() tests them, as leaves (voxelLeaf(), ascending v) counting min(count[v],
- * the box test's bound).
+ *        @p target readings as screenLevel() tests them, as leaves (voxelLeaf(), ascending v)
+ *        counting min(count[v], the box test's bound).
  */
 std::vector<LeafBox> reachingLeaves(const GridSpec& spec, const std::vector<std::uint8_t>& count, int target,
                                     const BlockMaxima& blocks, const BoxScreen& screen);

@@ -251,17 +251,22 @@ std::vector<VoxelCluster> regionalPlateaus(const GridSpec& spec, const std::vect
   return clusters;
 }
 
-std::vector<std::size_t> nonMaximalPlateaus(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
-                                            const std::vector<std::size_t>& above)
+std::vector<std::size_t> liftNonMaximalPlateaus(const GridSpec& spec, std::vector<std::uint8_t>& count, int level,
+                                                const std::vector<std::size_t>& above)
 {
-  BitFlags seen(count.size());
+  std::vector<std::size_t> lifted;
+  if (level < 0 || level > 254)
+  {
+    return lifted;
+  }
+  // A voxel lifted is above the level: the count itself marks what the flood has reached.
+  const auto up = static_cast<std::uint8_t>(level + 1);
   const Neighbours neighbours(spec);
-  std::vector<std::size_t> found;
   auto visit = [&](std::size_t w) {
-    if (count[w] == level && !seen.test(w))
+    if (count[w] == level)
     {
-      seen.set(w);
-      found.push_back(w);
+      count[w] = up;
+      lifted.push_back(w);
     }
     return true;
   };
@@ -269,11 +274,11 @@ std::vector<std::size_t> nonMaximalPlateaus(const GridSpec& spec, const std::vec
   {
     neighbours.until(u, visit);
   }
-  for (std::size_t head = 0; head < found.size(); ++head)
+  for (std::size_t head = 0; head < lifted.size(); ++head)
   {
-    neighbours.until(found[head], visit);
+    neighbours.until(lifted[head], visit);
   }
-  return found;
+  return lifted;
 }
 
 std::vector<std::size_t> withNeighbourBelow(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,

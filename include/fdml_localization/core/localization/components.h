@@ -80,12 +80,14 @@ std::vector<VoxelCluster> regionalPlateaus(const GridSpec& spec, const std::vect
                                            const std::vector<std::size_t>& candidates);
 
 /**
- * @brief The voxels at exactly @p level outside its regional maxima (regionalMaxima()): those
- *        connected, through voxels at the level, to a voxel above it, in flood order. @p above
- *        must list every voxel above the level with a neighbour at it (others do no harm).
+ * @brief Lifts to @p level + 1 (0 <= level <= 254) the voxels at exactly @p level outside its
+ *        regional maxima (regionalMaxima()): those connected, through voxels at the level, to a
+ *        voxel above it. @p above must list every voxel above the level with a neighbour at it
+ *        (others do no harm).
+ * @return the voxels lifted, in flood order
  */
-std::vector<std::size_t> nonMaximalPlateaus(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
-                                            const std::vector<std::size_t>& above);
+std::vector<std::size_t> liftNonMaximalPlateaus(const GridSpec& spec, std::vector<std::uint8_t>& count, int level,
+                                                const std::vector<std::size_t>& above);
 
 /// The voxels of @p voxels (same order) with a neighbour whose count is below @p level.
 std::vector<std::size_t> withNeighbourBelow(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,

@@ -55,11 +55,7 @@ std::vector<VoxelCluster> ScreenedCount::maximaAt(int level, const BoxScreen& sc
   next_level_ = level - 1;
   // The plateaus touching a voxel above the level are no maxima: lifted above it while the level
   // is screened (so they are not), then put back. (None at level 255: no count is above it.)
-  const std::vector<std::size_t> lower = nonMaximalPlateaus(spec_, count_, level, above_);
-  for (std::size_t v : lower)
-  {
-    count_[v] = static_cast<std::uint8_t>(level + 1);
-  }
+  const std::vector<std::size_t> lower = liftNonMaximalPlateaus(spec_, count_, level, above_);
   // The voxels failing are lowered to level - 1: no pose of them explains `level` readings.
   std::vector<std::size_t> kept;
   for (const VoxelVerdict& v : screenLevel(spec_, count_, level, blocks_, screen))

@@ -93,7 +93,7 @@ VoxelSets asSets(const std::vector<VoxelCluster>& clusters)
   return sets;
 }
 
-/// nonMaximalPlateaus() at @p level is the rest of the level (@p at_level) off its maxima
+/// liftNonMaximalPlateaus() at @p level lifts the rest of the level (@p at_level) off its maxima
 /// (@p maxima), found from the voxels above it touching one at or below it (withNeighbourBelow()).
 void expectOffMaximaFound(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
                           const std::vector<std::size_t>& at_level, const VoxelSets& maxima)
@@ -121,9 +121,14 @@ void expectOffMaximaFound(const GridSpec& spec, const std::vector<std::uint8_t>&
     }
   }
   ASSERT_EQ(withNeighbourBelow(spec, count, level + 1, above), touching);
-  std::vector<std::size_t> lower = nonMaximalPlateaus(spec, count, level, touching);
+  std::vector<std::uint8_t> lifted = count;
+  std::vector<std::size_t> lower = liftNonMaximalPlateaus(spec, lifted, level, touching);
   std::sort(lower.begin(), lower.end());
   EXPECT_EQ(lower, std::vector<std::size_t>(off_maxima.begin(), off_maxima.end())) << "level " << level;
+  for (std::size_t v = 0; v < count.size(); ++v)
+  {
+    ASSERT_EQ(lifted[v], off_maxima.count(v) ? level + 1 : count[v]) << "level " << level << " voxel " << v;
+  }
 }
 
 TEST(CountBuckets, RegionalMaximaOfRandomFieldsMatchABruteForce)

@@ -100,7 +100,8 @@ public:
         }
         else if (lowered_)
         {
-          // Below the readings needed the test stops early: its count bounds nothing.
+          // No pose of it explains the readings needed (below them the test stops early, so its
+          // count bounds nothing): needed - 1 does.
           lowered_[v] = static_cast<std::uint8_t>(needed_ - 1);
         }
       }

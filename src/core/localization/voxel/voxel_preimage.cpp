@@ -46,7 +46,14 @@ __attribute__((target("avx2"))) int markRowAvx2(const float* rmin_base, const fl
   return ix;
 }
 
-const bool kHaveAvx2 = __builtin_cpu_supports("avx2");
+/// Whether the CPU has AVX2 (the CPU model is read first: this runs among static initialisers).
+bool haveAvx2()
+{
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2");
+}
+
+const bool kHaveAvx2 = haveAvx2();
 #endif
 
 /// Sets bit ix of @p row for ix in [begin, end) when [rmin[ix + shift], rmax[ix + shift]] meets

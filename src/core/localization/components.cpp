@@ -105,6 +105,65 @@ void flood(const Neighbours& neighbours, std::size_t seed, BitFlags& visited, st
     });
   }
 }
+
+/// The plateaus of regionalMaxima() in the order they are found (first candidate first), without
+/// centroids.
+std::vector<VoxelCluster> regionalPlateaus(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
+                                           const std::vector<std::size_t>& candidates)
+{
+  std::vector<VoxelCluster> clusters;
+  // A flood stops at the first voxel above the level, or in a plateau already found not to be a
+  // maximum (`lower`): its voxels join `lower`. Floods stay in their plateau, so a finished one
+  // holds all of it, from the same first voxel and in the same order as a full flood.
+  BitFlags seen(count.size());
+  BitFlags lower(count.size());
+  const Neighbours neighbours(spec);
+  std::vector<std::size_t> queue;
+  for (std::size_t v : candidates)
+  {
+    if (seen.test(v) || count[v] != level)
+    {
+      continue;
+    }
+    queue.assign(1, v);
+    seen.set(v);
+    bool is_maximum = true;
+    for (std::size_t head = 0; head < queue.size() && is_maximum; ++head)
+    {
+      neighbours.until(queue[head], [&](std::size_t w) {
+        if (count[w] < level)
+        {
+          return true;
+        }
+        if (count[w] > level || lower.test(w))
+        {
+          is_maximum = false;
+          return false;
+        }
+        if (!seen.test(w))
+        {
+          seen.set(w);
+          queue.push_back(w);
+        }
+        return true;
+      });
+    }
+    if (!is_maximum)
+    {
+      for (std::size_t u : queue)
+      {
+        lower.set(u);
+      }
+      continue;
+    }
+    VoxelCluster cluster;
+    cluster.voxels = queue;
+    cluster.peak_count = level;
+    clusters.push_back(std::move(cluster));
+  }
+  return clusters;
+}
+
 }  // namespace
 
 void computeCentroid(const GridSpec& spec, VoxelCluster& cluster)
@@ -193,62 +252,6 @@ std::vector<std::size_t> componentSizes(const GridSpec& spec, const std::vector<
                                         const std::vector<std::size_t>& seeds)
 {
   return LevelRuns(spec, count, level).componentSizes(seeds);
-}
-
-std::vector<VoxelCluster> regionalPlateaus(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
-                                           const std::vector<std::size_t>& candidates)
-{
-  std::vector<VoxelCluster> clusters;
-  // A flood stops at the first voxel above the level, or in a plateau already found not to be a
-  // maximum (`lower`): its voxels join `lower`. Floods stay in their plateau, so a finished one
-  // holds all of it, from the same first voxel and in the same order as a full flood.
-  BitFlags seen(count.size());
-  BitFlags lower(count.size());
-  const Neighbours neighbours(spec);
-  std::vector<std::size_t> queue;
-  for (std::size_t v : candidates)
-  {
-    if (seen.test(v) || count[v] != level)
-    {
-      continue;
-    }
-    queue.assign(1, v);
-    seen.set(v);
-    bool is_maximum = true;
-    for (std::size_t head = 0; head < queue.size() && is_maximum; ++head)
-    {
-      neighbours.until(queue[head], [&](std::size_t w) {
-        if (count[w] < level)
-        {
-          return true;
-        }
-        if (count[w] > level || lower.test(w))
-        {
-          is_maximum = false;
-          return false;
-        }
-        if (!seen.test(w))
-        {
-          seen.set(w);
-          queue.push_back(w);
-        }
-        return true;
-      });
-    }
-    if (!is_maximum)
-    {
-      for (std::size_t u : queue)
-      {
-        lower.set(u);
-      }
-      continue;
-    }
-    VoxelCluster cluster;
-    cluster.voxels = queue;
-    cluster.peak_count = level;
-    clusters.push_back(std::move(cluster));
-  }
-  return clusters;
 }
 
 std::vector<std::size_t> liftNonMaximalPlateaus(const GridSpec& spec, std::vector<std::uint8_t>& count, int level,

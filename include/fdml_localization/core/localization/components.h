@@ -74,11 +74,6 @@ std::size_t componentSize(const GridSpec& spec, const std::vector<std::uint8_t>&
 std::vector<std::size_t> componentSizes(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
                                         const std::vector<std::size_t>& seeds);
 
-/// The plateaus of regionalMaxima() in the order they are found (first candidate first), without
-/// centroids.
-std::vector<VoxelCluster> regionalPlateaus(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
-                                           const std::vector<std::size_t>& candidates);
-
 /**
  * @brief Lifts to @p level + 1 (0 <= level <= 254) the voxels at exactly @p level outside its
  *        regional maxima (regionalMaxima()): those connected, through voxels at the level, to a

@@ -3,13 +3,15 @@
 #include "fdml_localization/core/localization/count_scan.h"
 
 #include <algorithm>
+#include <cstring>
 
 namespace fdml_localization
 {
 namespace core
 {
-CountBuckets::CountBuckets(const std::vector<std::uint8_t>& count, int lowest, int k)
+CountBuckets::CountBuckets(const std::vector<std::uint8_t>& count, int row_length, int lowest, int k)
   : count_(count)
+  , row_length_(static_cast<std::size_t>(std::max(row_length, 1)))
   , lowest_(lowest)
   , k_(k)
   , buckets_(static_cast<std::size_t>(std::max(k, 0)) + 1)
@@ -18,14 +20,44 @@ CountBuckets::CountBuckets(const std::vector<std::uint8_t>& count, int lowest, i
 
 const std::vector<std::size_t>& CountBuckets::at(int level)
 {
-  if (level < lowest_ || level > k_)
+  if (level < std::max(lowest_, 1) || level > std::min(k_, 255))
   {
     return none_;
   }
   if (!built_[level])
   {
-    buckets_[level] = std::move(voxelsByCount(count_, level, level)[level]);
     built_[level] = 1;
+    const std::size_t rows = count_.size() / row_length_;
+    if (row_max_.empty())
+    {
+      row_max_.resize(rows + 1);  // the last entry: a partial row, if any
+      for (std::size_t r = 0; r * row_length_ < count_.size(); ++r)
+      {
+        const auto first = count_.begin() + static_cast<std::ptrdiff_t>(r * row_length_);
+        const auto last = count_.begin() + static_cast<std::ptrdiff_t>(std::min(count_.size(), (r + 1) * row_length_));
+        row_max_[r] = *std::max_element(first, last);
+      }
+    }
+    std::vector<std::size_t>& out = buckets_[level];
+    const unsigned value = static_cast<unsigned>(level);
+    for (std::size_t r = 0; r < row_max_.size(); ++r)
+    {
+      const std::size_t end = std::min(count_.size(), (r + 1) * row_length_);
+      for (std::size_t v = r * row_length_; row_max_[r] >= level && v < end;)
+      {
+        std::uint64_t word = 0;
+        if (v + 8 <= end && (std::memcpy(&word, count_.data() + v, 8), !anyByteEqual(word, value)))
+        {
+          v += 8;  // none of these eight at the level
+          continue;
+        }
+        if (count_[v] == level)
+        {
+          out.push_back(v);
+        }
+        ++v;
+      }
+    }
   }
   return buckets_[level];
 }

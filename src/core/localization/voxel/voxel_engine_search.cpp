@@ -52,8 +52,8 @@ public:
     , gate_(gate)
     , times_(times)
     , conservative_(engine.grid(), engine.lastCount(), blocks)
-    , buckets_(engine.lastSeedCount(), lowest, k)
-    , raw_buckets_(engine.lastRawCount(), lowest, k)
+    , buckets_(engine.lastSeedCount(), engine.grid().nx, lowest, k)
+    , raw_buckets_(engine.lastRawCount(), engine.grid().nx, lowest, k)
   {}
 
   std::vector<SearchSeed> seedsAt(int level) override

@@ -152,7 +152,7 @@ TEST(CountBuckets, RegionalMaximaOfRandomFieldsMatchABruteForce)
       const int it = static_cast<int>(v / (static_cast<std::size_t>(spec.nx) * spec.ny));
       count[v] = count[spec.index(ix - ix % 2, iy - iy % 2, it)];
     }
-    CountBuckets buckets(count, 1, 5);
+    CountBuckets buckets(count, spec.nx, 1, 5);
     for (int level = 5; level >= 1; --level)
     {
       std::vector<std::size_t> plain;

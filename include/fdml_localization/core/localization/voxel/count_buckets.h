@@ -18,21 +18,24 @@ namespace fdml_localization
 {
 namespace core
 {
-/// The voxels of a count field by count (voxelsByCount()), each level bucketed when first asked
-/// for: the low levels hold most voxels and are rarely reached.
+/// The voxels of a count field by count, each level bucketed when first asked for: the low levels
+/// hold most voxels and are rarely reached. Only the rows (of @p row_length voxels) whose largest
+/// count reaches a level are scanned for it.
 class CountBuckets
 {
 public:
   /// @p count must outlive the buckets; levels outside [@p lowest, @p k] hold no voxel.
-  CountBuckets(const std::vector<std::uint8_t>& count, int lowest, int k);
+  CountBuckets(const std::vector<std::uint8_t>& count, int row_length, int lowest, int k);
 
   /// The voxels (ascending) whose count is @p level; none below the lowest level.
   const std::vector<std::size_t>& at(int level);
 
 private:
   const std::vector<std::uint8_t>& count_;
+  std::size_t row_length_;
   int lowest_;
   int k_;
+  std::vector<std::uint8_t> row_max_;  ///< by row: its largest count (found on the first call)
   std::vector<std::vector<std::size_t>> buckets_;
   std::vector<char> built_;  ///< by level: bucketed
   const std::vector<std::size_t> none_;

@@ -1,5 +1,6 @@
 #include "fdml_localization/core/localization/components.h"
 
+#include "fdml_localization/core/localization/count_scan.h"
 #include "fdml_localization/core/localization/level_runs.h"
 
 #include <algorithm>
@@ -224,8 +225,16 @@ std::vector<VoxelCluster> connectedComponents(const GridSpec& spec, const std::v
   const Neighbours neighbours(spec);
   std::vector<std::size_t> queue;
   auto inside = [&](std::size_t u) { return count[u] >= level; };
+  const bool words = level >= 1 && level <= 128;
   for (std::size_t v = 0; v < count.size(); ++v)
   {
+    std::uint64_t word = 0;
+    if (words && v % 8 == 0 && v + 8 <= count.size() &&
+        (std::memcpy(&word, count.data() + v, 8), !anyByteAtLeast(word, static_cast<unsigned>(level))))
+    {
+      v += 7;  // none of these eight reaches the level
+      continue;
+    }
     if (count[v] < level || visited.test(v))
     {
       continue;

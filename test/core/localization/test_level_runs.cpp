@@ -1,6 +1,7 @@
-// Component sizes found run by run (level_runs.h) against a voxel-by-voxel flood written out
-// here, on random fields with components of every shape, including grids of one and two headings
-// (the heading's neighbours wrap onto the same row).
+// Component sizes found run by run (level_runs.h), and the components themselves
+// (connectedComponents()), against a voxel-by-voxel flood written out here, on random fields
+// with components of every shape, including grids of one and two headings (the heading's
+// neighbours wrap onto the same row).
 #include "fdml_localization/core/localization/level_runs.h"
 
 #include "fdml_localization/core/localization/components.h"
@@ -11,6 +12,7 @@
 
 #include <algorithm>
 #include <random>
+#include <set>
 
 namespace fdml_localization
 {
@@ -70,6 +72,24 @@ std::vector<std::size_t> bruteSizes(const GridSpec& spec, const std::vector<std:
   return sizes;
 }
 
+/// connectedComponents() covers the voxels reaching @p level once each, a cluster for each
+/// component of the brute force (@p expected: each voxel's component size).
+void expectComponentsMatch(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
+                           const std::vector<std::size_t>& expected)
+{
+  std::set<std::size_t> covered;
+  for (const VoxelCluster& cluster : connectedComponents(spec, count, level))
+  {
+    for (std::size_t v : cluster.voxels)
+    {
+      ASSERT_EQ(expected[v], cluster.voxels.size()) << "level " << level << " voxel " << v;
+      covered.insert(v);
+    }
+  }
+  const auto reaching = std::count_if(count.begin(), count.end(), [&](std::uint8_t c) { return c >= level; });
+  EXPECT_EQ(covered.size(), static_cast<std::size_t>(reaching)) << "level " << level;
+}
+
 TEST(LevelRuns, ComponentSizesMatchAVoxelFlood)
 {
   std::mt19937_64 rng(29);
@@ -106,6 +126,7 @@ TEST(LevelRuns, ComponentSizesMatchAVoxelFlood)
           ASSERT_EQ(sizes[k], expected[voxels[k]]) << "level " << level << " voxel " << voxels[k];
         }
         EXPECT_EQ(sizes.back(), 0u);
+        expectComponentsMatch(spec, count, level, expected);
         EXPECT_EQ(componentSize(spec, count, level, voxels.front()), expected[voxels.front()]);
         largest = std::max(largest, *std::max_element(expected.begin(), expected.end()));
       }

@@ -24,20 +24,21 @@ bool anyByteEqual(std::uint64_t word, unsigned value)
 
 namespace
 {
-/// Calls @p fn(v) for every voxel v (ascending) whose count lies in [lo, hi], lo >= 1.
+/// Calls @p fn(v) for every voxel v in [first, end) (ascending) whose count lies in [lo, hi],
+/// lo >= 1, skipping eight voxels at a time that hold none (hi == lo: none equal to it).
 template <typename Fn>
-void forEachVoxelIn(const std::vector<std::uint8_t>& count, unsigned lo, unsigned hi, Fn&& fn)
+void forEachVoxelIn(const std::vector<std::uint8_t>& count, std::size_t first, std::size_t end, unsigned lo,
+                    unsigned hi, Fn&& fn)
 {
-  const std::size_t n = count.size();
-  std::size_t v = 0;
+  std::size_t v = first;
+  end = std::min(end, count.size());
   if (lo > 255u || lo > hi)
   {
     return;
   }
   if (lo <= 128u)
   {
-    // Skip 8 voxels at a time while none reaches lo.
-    for (; v + 8 <= n; v += 8)
+    for (; v + 8 <= end; v += 8)
     {
       std::uint64_t word = 0;
       std::memcpy(&word, count.data() + v, 8);
@@ -54,7 +55,7 @@ void forEachVoxelIn(const std::vector<std::uint8_t>& count, unsigned lo, unsigne
       }
     }
   }
-  for (; v < n; ++v)
+  for (; v < end; ++v)
   {
     if (count[v] >= lo && count[v] <= hi)
     {
@@ -73,9 +74,20 @@ std::vector<std::vector<std::size_t>> voxelsByCount(const std::vector<std::uint8
     return buckets;
   }
   const auto lo = static_cast<unsigned>(std::clamp(min_level, 1, 256));
-  forEachVoxelIn(count, lo, static_cast<unsigned>(std::min(max_level, 255)),
+  forEachVoxelIn(count, 0, count.size(), lo, static_cast<unsigned>(std::min(max_level, 255)),
                  [&](std::size_t v) { buckets[count[v]].push_back(v); });
   return buckets;
+}
+
+void appendVoxelsAt(const std::vector<std::uint8_t>& count, std::size_t first, std::size_t end, int level,
+                    std::vector<std::size_t>& out)
+{
+  if (level < 1 || level > 255)
+  {
+    return;
+  }
+  const auto value = static_cast<unsigned>(level);
+  forEachVoxelIn(count, first, end, value, value, [&](std::size_t v) { out.push_back(v); });
 }
 
 }  // namespace core

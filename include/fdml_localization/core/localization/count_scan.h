@@ -27,5 +27,9 @@ bool anyByteEqual(std::uint64_t word, unsigned value);
 std::vector<std::vector<std::size_t>> voxelsByCount(const std::vector<std::uint8_t>& count, int min_level,
                                                     int max_level);
 
+/// Appends to @p out the voxels v in [first, end) (ascending) whose count is @p level (1 to 255).
+void appendVoxelsAt(const std::vector<std::uint8_t>& count, std::size_t first, std::size_t end, int level,
+                    std::vector<std::size_t>& out);
+
 }  // namespace core
 }  // namespace fdml_localization

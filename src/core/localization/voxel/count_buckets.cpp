@@ -3,7 +3,6 @@
 #include "fdml_localization/core/localization/count_scan.h"
 
 #include <algorithm>
-#include <cstring>
 
 namespace fdml_localization
 {
@@ -38,24 +37,11 @@ const std::vector<std::size_t>& CountBuckets::at(int level)
         row_max_[r] = *std::max_element(first, last);
       }
     }
-    std::vector<std::size_t>& out = buckets_[level];
-    const unsigned value = static_cast<unsigned>(level);
     for (std::size_t r = 0; r < row_max_.size(); ++r)
     {
-      const std::size_t end = std::min(count_.size(), (r + 1) * row_length_);
-      for (std::size_t v = r * row_length_; row_max_[r] >= level && v < end;)
+      if (row_max_[r] >= level)
       {
-        std::uint64_t word = 0;
-        if (v + 8 <= end && (std::memcpy(&word, count_.data() + v, 8), !anyByteEqual(word, value)))
-        {
-          v += 8;  // none of these eight at the level
-          continue;
-        }
-        if (count_[v] == level)
-        {
-          out.push_back(v);
-        }
-        ++v;
+        appendVoxelsAt(count_, r * row_length_, (r + 1) * row_length_, level, buckets_[level]);
       }
     }
   }

@@ -333,7 +333,8 @@ PolishOutcome polishPose(const MapRayCaster& map, const Pose2& start, const std:
       break;
     }
   }
-  out.covariance = poseCovariance(map, buildSystem(map, out.pose, readings, mounts, use, 0.0, hints), noise_sigma);
+  // sys is the system at out.pose: its information and residuals do not depend on the loss.
+  out.covariance = poseCovariance(map, sys, noise_sigma);
   return out;
 }
 

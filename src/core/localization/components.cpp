@@ -1,7 +1,7 @@
 #include "fdml_localization/core/localization/components.h"
 
 #include "fdml_localization/core/localization/count_scan.h"
-#include "fdml_localization/core/localization/level_runs.h"
+#include "fdml_localization/core/localization/level_masks.h"
 
 #include <algorithm>
 #include <cmath>
@@ -260,7 +260,7 @@ std::size_t componentSize(const GridSpec& spec, const std::vector<std::uint8_t>&
 std::vector<std::size_t> componentSizes(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
                                         const std::vector<std::size_t>& seeds)
 {
-  return LevelRuns(spec, count, level).componentSizes(seeds);
+  return LevelMasks(spec, count, level).componentSizes(seeds);
 }
 
 std::vector<std::size_t> liftNonMaximalPlateaus(const GridSpec& spec, std::vector<std::uint8_t>& count, int level,

@@ -1,88 +1,130 @@
-#include "fdml_localization/core/localization/level_runs.h"
-
-#include "fdml_localization/core/localization/count_scan.h"
+#include "fdml_localization/core/localization/level_masks.h"
 
 #include <algorithm>
-#include <cstring>
-#include <utility>
+#include <bitset>
 
 namespace fdml_localization
 {
 namespace core
 {
-LevelRuns::LevelRuns(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level)
+namespace
+{
+using Word = std::uint64_t;
+
+/// @p g spread towards higher bits through the consecutive bits of @p p (a Kogge-Stone occluded
+/// fill: each step doubles the reach).
+Word fillUp(Word g, Word p)
+{
+  for (int shift = 1; shift < 64; shift *= 2)
+  {
+    g |= p & (g << shift);
+    p &= p << shift;
+  }
+  return g;
+}
+
+/// fillUp() towards lower bits.
+Word fillDown(Word g, Word p)
+{
+  for (int shift = 1; shift < 64; shift *= 2)
+  {
+    g |= p & (g >> shift);
+    p &= p >> shift;
+  }
+  return g;
+}
+
+std::size_t popcount(Word w)
+{
+  return std::bitset<64>(w).count();
+}
+}  // namespace
+
+LevelMasks::LevelMasks(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level)
   : spec_(spec)
   , count_(count)
   , level_(level)
-  , runs_(static_cast<std::size_t>(spec.ny) * spec.nt)
-  , built_(runs_.size(), 0)
-  , labels_(runs_.size())
+  , words_((static_cast<std::size_t>(std::max(spec.nx, 0)) + 63) / 64)
+  , level_bits_(static_cast<std::size_t>(std::max(spec.ny, 0)) * std::max(spec.nt, 0) * words_, 0)
+  , built_(static_cast<std::size_t>(std::max(spec.ny, 0)) * std::max(spec.nt, 0), 0)
+  , reached_(level_bits_.size(), 0)
+  , queued_(built_.size(), 0)
+  , runs_(words_, 0)
 {}
 
-const std::vector<LevelRuns::Run>& LevelRuns::runsOf(std::size_t row)
+const LevelMasks::Word* LevelMasks::levelOf(std::size_t row)
 {
-  std::vector<Run>& runs = runs_[row];
-  if (built_[row])
+  Word* bits = level_bits_.data() + row * words_;
+  if (!built_[row])
   {
-    return runs;
+    built_[row] = 1;
+    const std::uint8_t* c = count_.data() + row * static_cast<std::size_t>(spec_.nx);
+    for (int x = 0; x < spec_.nx; ++x)
+    {
+      bits[x >> 6] |= static_cast<Word>(c[x] >= level_) << (x & 63);
+    }
   }
-  built_[row] = 1;
-  const std::uint8_t* c = count_.data() + row * static_cast<std::size_t>(spec_.nx);
-  const int nx = spec_.nx;
-  const bool words = level_ >= 1 && level_ <= 128;
-  for (int x = 0; x < nx;)
-  {
-    std::uint64_t word = 0;
-    if (words && x + 8 <= nx && (std::memcpy(&word, c + x, 8), !anyByteAtLeast(word, static_cast<unsigned>(level_))))
-    {
-      x += 8;  // eight voxels below the level
-      continue;
-    }
-    if (c[x] < level_)
-    {
-      ++x;
-      continue;
-    }
-    const int x0 = x;
-    while (x < nx && c[x] >= level_)
-    {
-      ++x;
-    }
-    runs.push_back(Run{ x0, x });
-  }
-  labels_[row].assign(runs.size(), -1);
-  return runs;
+  return bits;
 }
 
-long LevelRuns::runAt(std::size_t row, int x)
+std::size_t LevelMasks::fill(std::size_t row, const Word* seeds)
 {
-  const std::vector<Run>& runs = runsOf(row);
-  const auto it = std::upper_bound(runs.begin(), runs.end(), x, [](int v, const Run& r) { return v < r.x0; });
-  if (it == runs.begin() || (it - 1)->x1 <= x)
+  const Word* level = levelOf(row);
+  Word* reached = reached_.data() + row * words_;
+  // Runs are intervals: each of their voxels lies above or below a seed of theirs.
+  std::vector<Word>& runs = runs_;
+  Word carry = 0;  // the fill reached the previous word's top voxel
+  for (std::size_t w = 0; w < words_; ++w)
   {
-    return -1;
+    runs[w] = fillUp((seeds[w] & level[w]) | (carry & level[w]), level[w]);
+    carry = runs[w] >> 63;
   }
-  return static_cast<long>(it - runs.begin()) - 1;
+  carry = 0;
+  for (std::size_t w = words_; w-- > 0;)
+  {
+    runs[w] |= fillDown((seeds[w] & level[w]) | ((carry << 63) & level[w]), level[w]);
+    carry = runs[w] & 1;
+  }
+  std::size_t added = 0;
+  for (std::size_t w = 0; w < words_; ++w)
+  {
+    const Word fresh = runs[w] & ~reached[w];
+    reached[w] |= fresh;
+    added += popcount(fresh);
+  }
+  if (added > 0 && !queued_[row])
+  {
+    queued_[row] = 1;
+    stack_.push_back(row);
+  }
+  return added;
 }
 
-std::size_t LevelRuns::walk(std::size_t row, std::size_t run, int label)
+std::size_t LevelMasks::flood(std::size_t row, int x)
 {
+  std::vector<Word> seed(words_, 0);
+  seed[static_cast<std::size_t>(x) >> 6] = Word{ 1 } << (x & 63);
+  std::size_t voxels = fill(row, seed.data());
   const std::size_t ny = static_cast<std::size_t>(spec_.ny);
-  const int nt = spec_.nt;
-  std::size_t voxels = 0;
-  std::vector<std::pair<std::size_t, std::size_t>> stack{ { row, run } };
-  labels_[row][run] = label;
-  while (!stack.empty())
+  std::vector<Word> spread(words_);
+  std::vector<Word> seeds(words_);
+  while (!stack_.empty())
   {
-    const auto [r, i] = stack.back();
-    stack.pop_back();
-    const Run here = runs_[r][i];
-    voxels += static_cast<std::size_t>(here.x1 - here.x0);
+    const std::size_t r = stack_.back();
+    stack_.pop_back();
+    queued_[r] = 0;
+    // The row's voxels and their neighbours along x.
+    const Word* from = reached_.data() + r * words_;
+    for (std::size_t w = 0; w < words_; ++w)
+    {
+      spread[w] = from[w] | (from[w] << 1) | (from[w] >> 1) | (w > 0 ? from[w - 1] >> 63 : 0) |
+                  (w + 1 < words_ ? from[w + 1] << 63 : 0);
+    }
     const int iy = static_cast<int>(r % ny);
     const int it = static_cast<int>(r / ny);
     for (int dt = -1; dt <= 1; ++dt)
     {
-      const int t = (it + dt + nt) % nt;
+      const int t = (it + dt + spec_.nt) % spec_.nt;
       for (int dy = -1; dy <= 1; ++dy)
       {
         const int y = iy + dy;
@@ -91,48 +133,49 @@ std::size_t LevelRuns::walk(std::size_t row, std::size_t run, int label)
         {
           continue;  // a row's own runs never touch (a gap lies between them)
         }
-        // Runs meeting [x0 - 1, x1 + 1): x and the neighbours along it.
-        const std::vector<Run>& runs = runsOf(next);
-        auto j = std::lower_bound(runs.begin(), runs.end(), here.x0, [](const Run& a, int v) { return a.x1 < v; });
-        for (; j != runs.end() && j->x0 <= here.x1; ++j)
+        const Word* level = levelOf(next);
+        const Word* reached = reached_.data() + next * words_;
+        Word any = 0;
+        for (std::size_t w = 0; w < words_; ++w)
         {
-          int& l = labels_[next][static_cast<std::size_t>(j - runs.begin())];
-          if (l < 0)
-          {
-            l = label;
-            stack.emplace_back(next, static_cast<std::size_t>(j - runs.begin()));
-          }
+          seeds[w] = spread[w] & level[w] & ~reached[w];
+          any |= seeds[w];
         }
+        voxels += any != 0 ? fill(next, seeds.data()) : 0;
       }
     }
   }
   return voxels;
 }
 
-std::vector<std::size_t> LevelRuns::componentSizes(const std::vector<std::size_t>& voxels)
+std::vector<std::size_t> LevelMasks::componentSizes(const std::vector<std::size_t>& voxels)
 {
   std::vector<std::size_t> sizes(voxels.size(), 0);
-  std::vector<std::size_t> by_label;
   const std::size_t nx = static_cast<std::size_t>(spec_.nx);
+  // The seeds not yet in a flooded component (each component is flooded once: the seeds it
+  // holds are found in it right after).
+  std::vector<std::size_t> open;
   for (std::size_t k = 0; k < voxels.size(); ++k)
   {
-    if (voxels[k] >= count_.size())
+    if (voxels[k] < count_.size() && count_[voxels[k]] >= level_)
     {
-      continue;
+      open.push_back(k);
     }
-    const std::size_t row = voxels[k] / nx;
-    const long run = runAt(row, static_cast<int>(voxels[k] % nx));
-    if (run < 0)
+  }
+  auto reached = [&](std::size_t v) {
+    const std::size_t x = v % nx;
+    return ((reached_[(v / nx) * words_ + x / 64] >> (x % 64)) & 1) != 0;
+  };
+  while (!open.empty())
+  {
+    const std::size_t v = voxels[open.front()];
+    const std::size_t size = flood(v / nx, static_cast<int>(v % nx));
+    const auto rest = std::partition(open.begin(), open.end(), [&](std::size_t k) { return !reached(voxels[k]); });
+    for (auto it = rest; it != open.end(); ++it)
     {
-      continue;
+      sizes[*it] = size;
     }
-    int& label = labels_[row][static_cast<std::size_t>(run)];
-    if (label < 0)
-    {
-      const int fresh = static_cast<int>(by_label.size());
-      by_label.push_back(walk(row, static_cast<std::size_t>(run), fresh));
-    }
-    sizes[k] = by_label[static_cast<std::size_t>(label)];
+    open.erase(rest, open.end());
   }
   return sizes;
 }

@@ -1,8 +1,8 @@
-// Component sizes found run by run (level_runs.h), and the components themselves
+// Component sizes flooded as bit masks (level_masks.h), and the components themselves
 // (connectedComponents()), against a voxel-by-voxel flood written out here, on random fields
 // with components of every shape, including grids of one and two headings (the heading's
-// neighbours wrap onto the same row).
-#include "fdml_localization/core/localization/level_runs.h"
+// neighbours wrap onto the same row) and rows of one, two and three 64-voxel words.
+#include "fdml_localization/core/localization/level_masks.h"
 
 #include "fdml_localization/core/localization/components.h"
 
@@ -90,20 +90,22 @@ void expectComponentsMatch(const GridSpec& spec, const std::vector<std::uint8_t>
   EXPECT_EQ(covered.size(), static_cast<std::size_t>(reaching)) << "level " << level;
 }
 
-TEST(LevelRuns, ComponentSizesMatchAVoxelFlood)
+TEST(LevelMasks, ComponentSizesMatchAVoxelFlood)
 {
   std::mt19937_64 rng(29);
   std::size_t largest = 0;
-  for (const GridSpec& spec :
-       { test::smallSpec(23, 11, 9), test::smallSpec(9, 7, 1), test::smallSpec(17, 5, 2), test::smallSpec(70, 4, 6) })
+  for (const GridSpec& spec : { test::smallSpec(23, 11, 9), test::smallSpec(9, 7, 1), test::smallSpec(17, 5, 2),
+                                test::smallSpec(70, 4, 6), test::smallSpec(64, 3, 3), test::smallSpec(150, 3, 2) })
   {
     for (int trial = 0; trial < 12; ++trial)
     {
-      // Runs of random lengths and values: long runs, gaps of one voxel, single voxels.
+      // Runs of random lengths and values: long runs (across 64-voxel words), gaps of one
+      // voxel, single voxels.
       std::vector<std::uint8_t> count(spec.voxelCount());
+      const std::size_t longest = trial % 4 == 3 ? 90 : trial % 3 == 0 ? 12 : 3;
       for (std::size_t v = 0; v < count.size();)
       {
-        const std::size_t length = 1 + rng() % (trial % 3 == 0 ? 12 : 3);
+        const std::size_t length = 1 + rng() % longest;
         const std::uint8_t value = static_cast<std::uint8_t>(rng() % 6);
         for (std::size_t j = 0; j < length && v < count.size(); ++j)
         {
@@ -133,6 +135,28 @@ TEST(LevelRuns, ComponentSizesMatchAVoxelFlood)
     }
   }
   EXPECT_GT(largest, 100u);  // components span many runs and rows
+}
+
+TEST(LevelMasks, DiagonalNeighboursAcrossWords)
+{
+  // Pairs of voxels touching only diagonally, across the boundaries of the 64-voxel words of a
+  // row: (63, 0)-(64, 1), (128, 0)-(127, 1), and (191, 1)-(192, 0) two headings apart in theta.
+  const GridSpec spec = test::smallSpec(200, 2, 3);
+  std::vector<std::uint8_t> count(spec.voxelCount(), 0);
+  const std::vector<std::size_t> voxels{ spec.index(63, 0, 0),  spec.index(64, 1, 0),  spec.index(128, 0, 1),
+                                         spec.index(127, 1, 1), spec.index(191, 1, 0), spec.index(192, 0, 2) };
+  for (std::size_t v : voxels)
+  {
+    count[v] = 4;
+  }
+  EXPECT_EQ(componentSizes(spec, count, 3, voxels), std::vector<std::size_t>(voxels.size(), 2u));
+  const std::vector<std::size_t> brute = bruteSizes(spec, count, 3);
+  for (std::size_t v : voxels)
+  {
+    // From each end alone: the flood crosses the word boundary upwards and downwards.
+    EXPECT_EQ(componentSize(spec, count, 3, v), 2u) << "voxel " << v;
+    EXPECT_EQ(brute[v], 2u) << "voxel " << v;
+  }
 }
 
 }  // namespace

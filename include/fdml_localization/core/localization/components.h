@@ -69,8 +69,8 @@ std::vector<VoxelCluster> connectedComponents(const GridSpec& spec, const std::v
  */
 std::size_t componentSize(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level, std::size_t seed);
 
-/// componentSize() for several seeds at once; each component is walked once, run by run
-/// (LevelRuns).
+/// componentSize() for several seeds at once; each component is flooded once, 64 voxels along x
+/// at a time (LevelMasks).
 std::vector<std::size_t> componentSizes(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
                                         const std::vector<std::size_t>& seeds);
 

@@ -38,10 +38,10 @@ void slidingPeriodic(const std::vector<float>& in, int m, Better better, std::ve
   }
 }
 
-/// Per padded cell column, the min (or max) over theta cells t .. t + m - 1.
-std::vector<float> alongTheta(const std::vector<float>& src, int nt, int m, bool theta_min)
+/// Per padded cell column, the min (or max) over theta cells t .. t + m - 1, into @p along.
+void alongTheta(const std::vector<float>& src, int nt, int m, bool theta_min, UninitialisedVector<float>& along)
 {
-  std::vector<float> along(src.size());
+  along.resize(src.size());
   const std::size_t pslice = src.size() / static_cast<std::size_t>(nt);
 #pragma omp parallel
   {
@@ -70,15 +70,14 @@ std::vector<float> alongTheta(const std::vector<float>& src, int nt, int m, bool
       }
     }
   }
-  return along;
 }
 
 /// Min (lower) or max over 2 x 2 padded cells: window (wx, wy) = cells (wx .. wx + 1, wy .. wy + 1).
-std::vector<float> positionWindows(const std::vector<float>& along, const GridSpec& spec, bool lower)
+UninitialisedVector<float> positionWindows(const UninitialisedVector<float>& along, const GridSpec& spec, bool lower)
 {
   const int pnx = spec.nx + 1;
   const std::size_t pslice = static_cast<std::size_t>(pnx) * (spec.ny + 1);
-  std::vector<float> result(spec.voxelCount());
+  UninitialisedVector<float> result(spec.voxelCount());  // every entry written below
 #pragma omp parallel for schedule(static)
   for (int t = 0; t < spec.nt; ++t)
   {
@@ -107,13 +106,12 @@ void BoundWindows::require(Kind kind, int m)
   if (arrays_.count(key) == 0)
   {
     const bool lower = kind == Kind::Lower;
-    const std::vector<float> along =
-        alongTheta(lower ? cells_.lower() : cells_.upper(), cells_.spec().nt, m, kind != Kind::UpperMax);
-    arrays_.emplace(key, positionWindows(along, cells_.spec(), lower));
+    alongTheta(lower ? cells_.lower() : cells_.upper(), cells_.spec().nt, m, kind != Kind::UpperMax, along_);
+    arrays_.emplace(key, positionWindows(along_, cells_.spec(), lower));
   }
 }
 
-const std::vector<float>& BoundWindows::get(Kind kind, int m) const
+const UninitialisedVector<float>& BoundWindows::get(Kind kind, int m) const
 {
   const auto it = arrays_.find(std::make_pair(static_cast<int>(kind), m));
   if (it == arrays_.end())
@@ -125,7 +123,7 @@ const std::vector<float>& BoundWindows::get(Kind kind, int m) const
 
 std::size_t BoundWindows::memoryBytes() const
 {
-  std::size_t total = cells_.memoryBytes();
+  std::size_t total = cells_.memoryBytes() + along_.capacity() * sizeof(float);
   for (const auto& [key, a] : arrays_)
   {
     total += a.capacity() * sizeof(float);

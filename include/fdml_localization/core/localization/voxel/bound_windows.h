@@ -8,6 +8,7 @@
 #pragma once
 
 #include "fdml_localization/core/localization/voxel/cell_bounds.h"
+#include "fdml_localization/core/util/uninitialised.h"
 
 #include <map>
 #include <utility>
@@ -41,12 +42,13 @@ public:
   /// Computes the array unless it is already there (not thread-safe: call before parallel reads).
   void require(Kind kind, int m);
   /// A required array (throws std::logic_error when it was not required).
-  const std::vector<float>& get(Kind kind, int m) const;
+  const UninitialisedVector<float>& get(Kind kind, int m) const;
   std::size_t memoryBytes() const;
 
 private:
   CellBounds cells_;
-  std::map<std::pair<int, int>, std::vector<float>> arrays_;
+  std::map<std::pair<int, int>, UninitialisedVector<float>> arrays_;
+  UninitialisedVector<float> along_;  ///< require()'s scratch: the bounds over the heading window
 };
 
 }  // namespace core

@@ -4,6 +4,7 @@
 #include "fdml_localization/core/localization/adaptive/leaf_clustering.h"
 #include "fdml_localization/core/localization/adaptive/leaf_search.h"
 #include "fdml_localization/core/localization/components.h"
+#include "fdml_localization/core/localization/level_masks.h"
 #include "fdml_localization/core/localization/robust_search.h"
 
 #include <algorithm>
@@ -69,6 +70,39 @@ void certify(const MapRayCaster& map, const std::vector<Reading>& readings, doub
       regions.count - c.regions_covered - static_cast<int>(std::count(reachable.begin(), reachable.end(), 1));
   c.complete = c.regions_covered + c.regions_excluded == regions.count;
 }
+/// The voxels of @p spec whose (closed) box holds one of @p candidates' poses, in no order.
+std::vector<std::size_t> voxelsHolding(const GridSpec& spec, const std::vector<Candidate>& candidates)
+{
+  std::vector<std::size_t> voxels;
+  for (const Candidate& candidate : candidates)
+  {
+    const Pose2& p = candidate.pose;
+    const double fx = std::floor((p.x - spec.origin_x) / spec.cell);
+    const double fy = std::floor((p.y - spec.origin_y) / spec.cell);
+    const double ft = std::floor((wrapAngle(p.theta) + kPi) / spec.thetaStep());
+    if (!(fx >= -1.0 && fx <= spec.nx && fy >= -1.0 && fy <= spec.ny && ft >= -1.0 && ft <= spec.nt))
+    {
+      continue;  // outside the grid (or not finite)
+    }
+    // A closed box holds a pose on its border too: the cells next to the one computed.
+    for (int it = static_cast<int>(ft) - 1; it <= static_cast<int>(ft) + 1; ++it)
+    {
+      for (int iy = std::max(static_cast<int>(fy) - 1, 0); iy <= std::min(static_cast<int>(fy) + 1, spec.ny - 1); ++iy)
+      {
+        for (int ix = std::max(static_cast<int>(fx) - 1, 0); ix <= std::min(static_cast<int>(fx) + 1, spec.nx - 1);
+             ++ix)
+        {
+          const std::size_t v = spec.index(ix, iy, (it + spec.nt) % spec.nt);
+          if (voxelBox(spec, v).contains(p))
+          {
+            voxels.push_back(v);
+          }
+        }
+      }
+    }
+  }
+  return voxels;
+}
 }  // namespace
 
 int consensusWithin(const MapRayCaster& map, const Pose2& pose, const std::vector<Reading>& readings, double tolerance)
@@ -104,6 +138,21 @@ void certifyVoxels(const MapRayCaster& map, const std::vector<Reading>& readings
                    const GridSpec& spec, const std::vector<std::uint8_t>& count, Result& result)
 {
   const int bound = count.empty() ? -1 : *std::max_element(count.begin(), count.end());
+  const int best =
+      result.candidates.empty() ? 0 : consensusWithin(map, result.candidates.front().pose, readings, tolerance);
+  if (bound > 0 && best != bound)
+  {
+    // Incomplete whatever the regions hold (certify()): only how many there are and how many
+    // hold a candidate, from bit masks, without listing their voxels.
+    Certificate& c = result.certificate;
+    c.max_consensus_bound = bound;
+    c.best_consensus = best;
+    std::size_t holding = 0;
+    c.regions_at_bound = static_cast<int>(
+        LevelMasks(spec, count, bound).componentCount(voxelsHolding(spec, result.candidates), holding));
+    c.regions_covered = static_cast<int>(holding);
+    return;
+  }
   BoundRegions regions;
   if (bound > 0)
   {

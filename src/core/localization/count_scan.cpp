@@ -14,6 +14,15 @@ bool anyByteAtLeast(std::uint64_t word, unsigned lo)
   return (((word + kOnes * (128u - lo)) | word) & kTops) != 0;
 }
 
+unsigned bytesAtLeast(std::uint64_t word, unsigned lo)
+{
+  constexpr std::uint64_t kOnes = 0x0101010101010101ull;
+  constexpr std::uint64_t kTops = 0x8080808080808080ull;
+  const std::uint64_t tops = (((word | kTops) - kOnes * lo) | word) & kTops;
+  // Gathers the eight top bits (at 8 i + 7) into the top byte, in order.
+  return static_cast<unsigned>(((tops >> 7) * 0x0102040810204080ull) >> 56);
+}
+
 bool anyByteEqual(std::uint64_t word, unsigned value)
 {
   constexpr std::uint64_t kOnes = 0x0101010101010101ull;

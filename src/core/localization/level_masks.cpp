@@ -1,7 +1,9 @@
 #include "fdml_localization/core/localization/level_masks.h"
 
+#include "fdml_localization/core/localization/count_scan.h"
+
 #include <algorithm>
-#include <bitset>
+#include <cstring>
 
 namespace fdml_localization
 {
@@ -36,7 +38,7 @@ Word fillDown(Word g, Word p)
 
 std::size_t popcount(Word w)
 {
-  return std::bitset<64>(w).count();
+  return static_cast<std::size_t>(__builtin_popcountll(w));
 }
 }  // namespace
 
@@ -59,7 +61,17 @@ const LevelMasks::Word* LevelMasks::levelOf(std::size_t row)
   {
     built_[row] = 1;
     const std::uint8_t* c = count_.data() + row * static_cast<std::size_t>(spec_.nx);
-    for (int x = 0; x < spec_.nx; ++x)
+    int x = 0;
+    if (level_ >= 1 && level_ <= 128)
+    {
+      for (; x + 8 <= spec_.nx; x += 8)  // eight voxels at a time
+      {
+        std::uint64_t word = 0;
+        std::memcpy(&word, c + x, 8);
+        bits[x >> 6] |= static_cast<Word>(bytesAtLeast(word, static_cast<unsigned>(level_))) << (x & 63);
+      }
+    }
+    for (; x < spec_.nx; ++x)
     {
       bits[x >> 6] |= static_cast<Word>(c[x] >= level_) << (x & 63);
     }
@@ -148,28 +160,29 @@ std::size_t LevelMasks::flood(std::size_t row, int x)
   return voxels;
 }
 
-std::vector<std::size_t> LevelMasks::componentSizes(const std::vector<std::size_t>& voxels)
+std::size_t LevelMasks::floodEach(const std::vector<std::size_t>& voxels, std::vector<std::size_t>& sizes)
 {
-  std::vector<std::size_t> sizes(voxels.size(), 0);
   const std::size_t nx = static_cast<std::size_t>(spec_.nx);
-  // The seeds not yet in a flooded component (each component is flooded once: the seeds it
-  // holds are found in it right after).
-  std::vector<std::size_t> open;
-  for (std::size_t k = 0; k < voxels.size(); ++k)
-  {
-    if (voxels[k] < count_.size() && count_[voxels[k]] >= level_)
-    {
-      open.push_back(k);
-    }
-  }
   auto reached = [&](std::size_t v) {
     const std::size_t x = v % nx;
     return ((reached_[(v / nx) * words_ + x / 64] >> (x % 64)) & 1) != 0;
   };
+  // The voxels not yet in a flooded component (each component is flooded once: the voxels it
+  // holds are found in it right after).
+  std::vector<std::size_t> open;
+  for (std::size_t k = 0; k < voxels.size(); ++k)
+  {
+    if (voxels[k] < count_.size() && count_[voxels[k]] >= level_ && !reached(voxels[k]))
+    {
+      open.push_back(k);
+    }
+  }
+  std::size_t floods = 0;
   while (!open.empty())
   {
     const std::size_t v = voxels[open.front()];
     const std::size_t size = flood(v / nx, static_cast<int>(v % nx));
+    ++floods;
     const auto rest = std::partition(open.begin(), open.end(), [&](std::size_t k) { return !reached(voxels[k]); });
     for (auto it = rest; it != open.end(); ++it)
     {
@@ -177,7 +190,35 @@ std::vector<std::size_t> LevelMasks::componentSizes(const std::vector<std::size_
     }
     open.erase(rest, open.end());
   }
+  floods_ += floods;
+  return floods;
+}
+
+std::vector<std::size_t> LevelMasks::componentSizes(const std::vector<std::size_t>& voxels)
+{
+  std::vector<std::size_t> sizes(voxels.size(), 0);
+  floodEach(voxels, sizes);
   return sizes;
+}
+
+std::size_t LevelMasks::componentCount(const std::vector<std::size_t>& voxels, std::size_t& holding)
+{
+  std::vector<std::size_t> sizes(voxels.size(), 0);
+  holding = floodEach(voxels, sizes);
+  for (std::size_t row = 0; row < built_.size(); ++row)
+  {
+    for (std::size_t w = 0; w < words_; ++w)
+    {
+      // The row's voxels reaching the level that no flood reached yet start new components.
+      for (Word open = levelOf(row)[w] & ~reached_[row * words_ + w]; open != 0;
+           open = levelOf(row)[w] & ~reached_[row * words_ + w])
+      {
+        flood(row, static_cast<int>(64 * w) + __builtin_ctzll(open));
+        ++floods_;
+      }
+    }
+  }
+  return floods_;
 }
 
 }  // namespace core

@@ -181,18 +181,24 @@ TEST(Components, WordTestsOfEightCountsMatchEachByte)
     const unsigned lo = 1u + static_cast<unsigned>(rng() % 128u);
     bool equal = false;
     bool at_least = false;
+    unsigned mask = 0;
     for (int b = 0; b < 8; ++b)
     {
       const unsigned byte = static_cast<unsigned>((word >> (8 * b)) & 0xffu);
       equal = equal || byte == value;
       at_least = at_least || byte >= lo;
+      mask |= (byte >= lo ? 1u : 0u) << b;
     }
     ASSERT_EQ(anyByteEqual(word, value), equal) << std::hex << word << " " << value;
     ASSERT_EQ(anyByteAtLeast(word, lo), at_least) << std::hex << word << " " << lo;
+    ASSERT_EQ(bytesAtLeast(word, lo), mask) << std::hex << word << " " << lo;
   }
   EXPECT_TRUE(anyByteEqual(0xff00000000000000ull, 255u));
   EXPECT_FALSE(anyByteEqual(0xffffffffffffff01ull, 0u));
   EXPECT_TRUE(anyByteEqual(0x0100000000000000ull, 1u));
+  // A byte of 255 next to one just below the level: no carry reaches it.
+  EXPECT_EQ(bytesAtLeast(0x7fff7fff7fff7fffull, 128u), 0x55u);
+  EXPECT_EQ(bytesAtLeast(0x0000000000000001ull, 1u), 0x01u);
 }
 
 TEST(HypothesisSeeds, MaximalSetsMatchBruteForce)

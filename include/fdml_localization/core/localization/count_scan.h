@@ -18,6 +18,11 @@ namespace core
 /// more already has it. Eight counts tested at once.
 bool anyByteAtLeast(std::uint64_t word, unsigned lo);
 
+/// The bytes of @p word at least @p lo (1 <= lo <= 128) as a mask, byte i (from the least
+/// significant) giving bit i: each byte with its top bit set minus lo cannot borrow from the
+/// next, and a byte of 128 or more has the top bit already.
+unsigned bytesAtLeast(std::uint64_t word, unsigned lo);
+
 /// Whether any of the 8 bytes of @p word equals @p value (<= 255): some byte of word ^ value
 /// is zero.
 bool anyByteEqual(std::uint64_t word, unsigned value);

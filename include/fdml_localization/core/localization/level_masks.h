@@ -28,6 +28,15 @@ public:
   /// the level or outside the grid); each component is flooded once.
   std::vector<std::size_t> componentSizes(const std::vector<std::size_t>& voxels);
 
+  /**
+   * @brief The number of connected components of the voxels reaching the level, each flooded
+   *        once (those an earlier call flooded are counted too).
+   * @param voxels voxels whose components are flooded first
+   * @param holding set to the number of components holding one of @p voxels (of those not
+   *        flooded before this call)
+   */
+  std::size_t componentCount(const std::vector<std::size_t>& voxels, std::size_t& holding);
+
 private:
   using Word = std::uint64_t;
 
@@ -39,6 +48,10 @@ private:
   /// The voxels of the component holding row @p row's voxel @p x (reaching the level), flooded
   /// into reached_.
   std::size_t flood(std::size_t row, int x);
+  /// Floods the component of each of @p voxels reaching the level not flooded yet; @p sizes[k]
+  /// (sized as @p voxels) set to the size of voxel k's component when this call floods it.
+  /// Returns the number of components flooded.
+  std::size_t floodEach(const std::vector<std::size_t>& voxels, std::vector<std::size_t>& sizes);
 
   const GridSpec& spec_;
   const std::vector<std::uint8_t>& count_;
@@ -50,6 +63,7 @@ private:
   std::vector<char> queued_;        ///< by row: on the flood's stack
   std::vector<std::size_t> stack_;  ///< rows whose new voxels are still to be spread
   std::vector<Word> runs_;          ///< fill()'s scratch row
+  std::size_t floods_ = 0;          ///< components flooded so far
 };
 
 }  // namespace core

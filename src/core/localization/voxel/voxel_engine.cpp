@@ -43,25 +43,27 @@ const ByteSpread kByteSpread;
 
 /**
  * @brief Writes to out[0, n) how many of @p rows hold each of the 64 voxels of their word @p w:
- *        the counts are added bit-sliced (plane b holds bit b of every voxel's count, at most
- *        255 rows), then spread to bytes eight voxels at a time.
+ *        the counts are added bit-sliced (plane b holds bit b of every voxel's count; @p used
+ *        planes, enough for rows.size() <= 255), then spread to bytes eight voxels at a time.
+ *        Every row ripples through all planes: a carry chain ending where the data says would
+ *        mispredict a branch per row.
  */
-void writeWordCounts(const std::vector<const std::uint64_t*>& rows, int w, std::uint8_t* out, int n)
+void writeWordCounts(const std::vector<const std::uint64_t*>& rows, int w, int used, std::uint8_t* out, int n)
 {
   std::uint64_t planes[8] = {};
-  int used = 0;
+  std::uint64_t any = 0;
   for (const std::uint64_t* row : rows)
   {
     std::uint64_t x = row[w];
-    for (int b = 0; x != 0 && b < 8; ++b)
+    any |= x;
+    for (int b = 0; b < used; ++b)
     {
       const std::uint64_t carry = planes[b] & x;
       planes[b] ^= x;
       x = carry;
-      used = std::max(used, b + 1);
     }
   }
-  if (used == 0)
+  if (any == 0)
   {
     std::memset(out, 0, static_cast<std::size_t>(n));
     return;
@@ -177,20 +179,37 @@ std::vector<VoxelSet> VoxelEngine::preimages(const std::vector<Reading>& reading
 
 std::vector<VoxelSet> VoxelEngine::preimages(const std::vector<Reading>& readings, std::vector<VoxelSet>& raw)
 {
+  std::vector<VoxelSet> sets;
+  preimagesInto(readings, sets, raw);
+  return sets;
+}
+
+void VoxelEngine::preimagesInto(const std::vector<Reading>& readings, std::vector<VoxelSet>& sets,
+                                std::vector<VoxelSet>& raw)
+{
   prepare();
   prepareWindows(readings);
   const long k = static_cast<long>(readings.size());
   const long nt = spec_.nt;
-  raw.assign(readings.size(), VoxelSet(spec_));
-  std::vector<VoxelSet> sets(readings.size(), VoxelSet(spec_));
+  for (std::vector<VoxelSet>* v : { &sets, &raw })
+  {
+    v->resize(readings.size());
+    for (VoxelSet& set : *v)
+    {
+      set.reshape(spec_);  // storage kept from the last batch; each slice cleared below
+    }
+  }
 #pragma omp parallel for schedule(static) num_threads(threads())
   for (long job = 0; job < k * nt; ++job)
   {
     const Reading& r = readings[job / nt];
-    fillPreimageSlice(r, static_cast<int>(job % nt), sets[job / nt]);
+    const int it = static_cast<int>(job % nt);
+    sets[job / nt].clearSlice(it);
+    raw[job / nt].clearSlice(it);
+    fillPreimageSlice(r, it, sets[job / nt]);
     if (!(r.half_angle > 0.0))
     {
-      fillSampleSlice(r, static_cast<int>(job % nt), raw[job / nt]);
+      fillSampleSlice(r, it, raw[job / nt]);
     }
   }
   for (std::size_t i = 0; i < readings.size(); ++i)
@@ -202,7 +221,6 @@ std::vector<VoxelSet> VoxelEngine::preimages(const std::vector<Reading>& reading
       raw[i] = sets[i];
     }
   }
-  return sets;
 }
 
 std::vector<VoxelSet> VoxelEngine::paperPreimages(const std::vector<Reading>& readings)
@@ -255,6 +273,11 @@ void VoxelEngine::countField(const std::vector<VoxelSet>& sets, std::vector<std:
   const int ny = spec_.ny;
   const int nt = spec_.nt;
   const int words = sets.front().wordsPerRow();
+  int used = 1;  // bit planes holding counts up to sets.size() (at most 255 readings)
+  while (used < 8 && (std::size_t{ 1 } << used) <= sets.size())
+  {
+    ++used;
+  }
 #pragma omp parallel for schedule(static) num_threads(threads())
   for (int it = 0; it < nt; ++it)
   {
@@ -268,7 +291,7 @@ void VoxelEngine::countField(const std::vector<VoxelSet>& sets, std::vector<std:
       std::uint8_t* out = count.data() + spec_.index(0, iy, it);
       for (int w = 0; w < words; ++w)
       {
-        writeWordCounts(rows, w, out + 64 * w, std::min(64, nx - 64 * w));
+        writeWordCounts(rows, w, used, out + 64 * w, std::min(64, nx - 64 * w));
       }
     }
   }
@@ -305,7 +328,7 @@ Result VoxelEngine::localize(const std::vector<Reading>& readings)
   auto stage = std::chrono::steady_clock::now();
   if (options_.method == Method::Robust)
   {
-    sets_ = preimages(readings, raw_sets_);
+    preimagesInto(readings, sets_, raw_sets_);
   }
   else
   {
@@ -323,7 +346,7 @@ Result VoxelEngine::localize(const std::vector<Reading>& readings)
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads())
     for (long i = 0; i < static_cast<long>(raw_sets_.size()); ++i)
     {
-      seed_sets_[i] = raw_sets_[i].dilated();
+      raw_sets_[i].dilateInto(seed_sets_[i]);
     }
     countField(seed_sets_, seed_count_);
   }

@@ -171,47 +171,88 @@ void VoxelSet::clear()
   std::fill(words_.begin(), words_.end(), 0);
 }
 
+void VoxelSet::clearSlice(int it)
+{
+  const std::size_t slice = static_cast<std::size_t>(ny_) * words_per_row_;
+  std::fill_n(words_.begin() + static_cast<std::ptrdiff_t>(it * slice), slice, 0);
+}
+
+void VoxelSet::reshape(const GridSpec& spec)
+{
+  nx_ = spec.nx;
+  ny_ = spec.ny;
+  nt_ = spec.nt;
+  words_per_row_ = (spec.nx + 63) / 64;
+  words_.resize(static_cast<std::size_t>(words_per_row_) * ny_ * nt_);
+}
+
 VoxelSet VoxelSet::dilated() const
 {
+  VoxelSet result;
+  dilateInto(result);
+  return result;
+}
+
+void VoxelSet::dilateInto(VoxelSet& out) const
+{
+  if (&out == this)
+  {
+    out = dilated();  // the input cannot be overwritten while it is read
+    return;
+  }
+  out.nx_ = nx_;
+  out.ny_ = ny_;
+  out.nt_ = nt_;
+  out.words_per_row_ = words_per_row_;
+  out.words_.resize(words_.size());
   const int wpr = words_per_row_;
-  const std::size_t rows = static_cast<std::size_t>(ny_) * nt_;
   const int tail_bits = nx_ - (wpr - 1) * 64;
   const std::uint64_t tail_mask = tail_bits >= 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << tail_bits) - 1;
-
-  // Along x, inside each row.
-  VoxelSet along_x(*this);
-  dilateAlongX(words_.data(), along_x.words_.data(), rows, wpr, tail_mask);
-  // Along y, inside each theta slice.
-  VoxelSet along_y(*this);
-  for (int it = 0; it < nt_; ++it)
+  const std::size_t slice = static_cast<std::size_t>(ny_) * wpr;
+  if (slice == 0 || nt_ <= 0)
   {
+    return;
+  }
+  // A slice dilated along x (inside each row) and then y: three of them (the slices before, at
+  // and after the one written) at a time, so every word is read and written once.
+  std::vector<std::uint64_t> along_x(slice);
+  std::vector<std::uint64_t> ring(3 * slice);
+  auto planar = [&](int it, std::uint64_t* dst) {
+    dilateAlongX(words_.data() + static_cast<std::size_t>(it) * slice, along_x.data(), static_cast<std::size_t>(ny_),
+                 wpr, tail_mask);
     for (int iy = 0; iy < ny_; ++iy)
     {
-      std::uint64_t* out = along_y.row(iy, it);
-      const std::uint64_t* mid = along_x.row(iy, it);
-      const std::uint64_t* lo = iy > 0 ? along_x.row(iy - 1, it) : nullptr;
-      const std::uint64_t* hi = iy + 1 < ny_ ? along_x.row(iy + 1, it) : nullptr;
+      const std::uint64_t* mid = along_x.data() + static_cast<std::size_t>(iy) * wpr;
+      const std::uint64_t* lo = iy > 0 ? mid - wpr : nullptr;
+      const std::uint64_t* hi = iy + 1 < ny_ ? mid + wpr : nullptr;
+      std::uint64_t* o = dst + static_cast<std::size_t>(iy) * wpr;
       for (int k = 0; k < wpr; ++k)
       {
-        out[k] = mid[k] | (lo ? lo[k] : 0) | (hi ? hi[k] : 0);
+        o[k] = mid[k] | (lo ? lo[k] : 0) | (hi ? hi[k] : 0);
       }
     }
-  }
+  };
+  std::uint64_t* prev = ring.data();
+  std::uint64_t* mid = prev + slice;
+  std::uint64_t* next = mid + slice;
+  planar(nt_ - 1, prev);
+  planar(0, mid);
+  planar(1 % nt_, next);
   // Along theta, periodic.
-  VoxelSet result(*this);
-  const std::size_t slice = static_cast<std::size_t>(ny_) * wpr;
   for (int it = 0; it < nt_; ++it)
   {
-    const std::uint64_t* prev = along_y.words_.data() + ((it + nt_ - 1) % nt_) * slice;
-    const std::uint64_t* mid = along_y.words_.data() + it * slice;
-    const std::uint64_t* next = along_y.words_.data() + ((it + 1) % nt_) * slice;
-    std::uint64_t* out = result.words_.data() + it * slice;
+    std::uint64_t* o = out.words_.data() + static_cast<std::size_t>(it) * slice;
     for (std::size_t k = 0; k < slice; ++k)
     {
-      out[k] = prev[k] | mid[k] | next[k];
+      o[k] = prev[k] | mid[k] | next[k];
+    }
+    std::swap(prev, mid);  // the slice at it becomes the one before it + 1 ...
+    std::swap(mid, next);  // ... and the one after it the one at it + 1
+    if (it + 1 < nt_)
+    {
+      planar((it + 2) % nt_, next);
     }
   }
-  return result;
 }
 
 VoxelSet& VoxelSet::operator&=(const VoxelSet& other)

@@ -46,18 +46,9 @@ TEST(VoxelGrid, FromMapUsesSquareCellsAndAMargin)
   }
 }
 
-TEST(VoxelGrid, DilationMatchesBruteForce)
+/// @p dilated is @p set dilated by one voxel (brute force over each voxel's neighbours).
+void expectDilationOf(const GridSpec& spec, const VoxelSet& set, const VoxelSet& dilated)
 {
-  const GridSpec spec = smallSpec(70, 5, 6);  // rows cross a word boundary
-  std::mt19937_64 rng(3);
-  VoxelSet set(spec);
-  for (int i = 0; i < 25; ++i)
-  {
-    set.set(static_cast<int>(rng() % 70), static_cast<int>(rng() % 5), static_cast<int>(rng() % 6));
-  }
-  set.set(63, 0, 0);
-  set.set(69, 4, 5);
-  const VoxelSet dilated = set.dilated();
   for (int it = 0; it < spec.nt; ++it)
   {
     for (int iy = 0; iy < spec.ny; ++iy)
@@ -72,12 +63,62 @@ TEST(VoxelGrid, DilationMatchesBruteForce)
           spec.unindex(u, x, y, t);
           expected = expected || set.test(x, y, t);
         });
-        ASSERT_EQ(dilated.test(ix, iy, it), expected) << ix << " " << iy << " " << it;
+        ASSERT_EQ(dilated.test(ix, iy, it), expected) << ix << " " << iy << " " << it << " of nt " << spec.nt;
       }
     }
   }
-  // Padding bits stay clear.
-  EXPECT_EQ(dilated.row(0, 0)[1] >> 6, 0u);
+}
+
+TEST(VoxelGrid, DilationMatchesBruteForce)
+{
+  // Rows crossing a word boundary; one, two, three and six headings (the periodic neighbours
+  // coincide on the smaller grids).
+  for (const int nt : { 6, 1, 2, 3 })
+  {
+    const GridSpec spec = smallSpec(70, 5, nt);
+    std::mt19937_64 rng(3 + nt);
+    VoxelSet set(spec);
+    for (int i = 0; i < 25; ++i)
+    {
+      set.set(static_cast<int>(rng() % 70), static_cast<int>(rng() % 5), static_cast<int>(rng() % nt));
+    }
+    set.set(63, 0, 0);
+    set.set(69, 4, nt - 1);
+    const VoxelSet dilated = set.dilated();
+    expectDilationOf(spec, set, dilated);
+    // Padding bits stay clear.
+    EXPECT_EQ(dilated.row(0, 0)[1] >> 6, 0u);
+    // Into a set of the same shape holding other bits (every word is written), and into itself.
+    VoxelSet reused(spec);
+    for (std::uint64_t& w : reused.words())
+    {
+      w = ~std::uint64_t{ 0 };
+    }
+    set.dilateInto(reused);
+    EXPECT_TRUE(reused == dilated) << "nt " << nt;
+    VoxelSet self = set;
+    self.dilateInto(self);
+    EXPECT_TRUE(self == dilated) << "nt " << nt;
+  }
+}
+
+TEST(VoxelGrid, SlicesClearAndReshapeKeepsTheShape)
+{
+  const GridSpec spec = smallSpec(70, 5, 4);
+  VoxelSet set;
+  set.reshape(spec);
+  set.clear();
+  set.set(3, 2, 1);
+  set.set(68, 4, 2);
+  set.clearSlice(1);
+  EXPECT_FALSE(set.test(3, 2, 1));
+  EXPECT_TRUE(set.test(68, 4, 2));
+  EXPECT_EQ(set.count(), 1u);
+  EXPECT_TRUE(set == [&] {
+    VoxelSet expected(spec);
+    expected.set(68, 4, 2);
+    return expected;
+  }());
 }
 
 TEST(DistanceTable, SamplesAndBlocksMatchBruteForce)

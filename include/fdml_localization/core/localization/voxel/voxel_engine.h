@@ -145,6 +145,9 @@ private:
   void prepareWindows(const std::vector<Reading>& readings);
   /// The seeding's sample test (not conservative): h - d changes sign among the 8 samples around
   /// (voxel centre) (+) g, band tau + half a cell.
+  /// preimages() into @p sets and @p raw, whose sets' storage is reused (each heading slice
+  /// cleared by the thread that fills it).
+  void preimagesInto(const std::vector<Reading>& readings, std::vector<VoxelSet>& sets, std::vector<VoxelSet>& raw);
   void fillSampleSlice(const Reading& reading, int it, VoxelSet& set) const;
   void fillPreimageSlice(const Reading& reading, int it, VoxelSet& set) const;
   void localizeRobust(const std::vector<Reading>& readings, Result& result);

@@ -133,9 +133,17 @@ public:
   /// Number of voxels in the set.
   std::size_t count() const;
   void clear();
+  /// Empties heading slice @p it.
+  void clearSlice(int it);
+  /// Takes @p spec's shape, keeping this set's storage where it is large enough; the bits are
+  /// left as they are (to be written in full, or cleared slice by slice).
+  void reshape(const GridSpec& spec);
   /// The set dilated by one voxel in every direction (3 x 3 x 3 box; theta wraps around,
   /// x and y are clipped at the grid's edge).
   VoxelSet dilated() const;
+  /// dilated() into @p out (another set), whose storage is reused (no allocation when it has
+  /// this shape).
+  void dilateInto(VoxelSet& out) const;
 
   VoxelSet& operator&=(const VoxelSet& other);
   VoxelSet& operator|=(const VoxelSet& other);

@@ -44,6 +44,25 @@ void dilateAlongX(const std::uint64_t* words, std::uint64_t* result, std::size_t
   }
 }
 
+/// One heading slice (@p ny rows of @p wpr words) dilated along x and y into @p out (@p along_x:
+/// scratch of the slice's size).
+void dilateSliceInPlane(const std::uint64_t* in, std::uint64_t* along_x, std::uint64_t* out, int ny, int wpr,
+                        std::uint64_t tail_mask)
+{
+  dilateAlongX(in, along_x, static_cast<std::size_t>(ny), wpr, tail_mask);
+  for (int iy = 0; iy < ny; ++iy)
+  {
+    const std::uint64_t* mid = along_x + static_cast<std::size_t>(iy) * wpr;
+    const std::uint64_t* lo = iy > 0 ? mid - wpr : nullptr;
+    const std::uint64_t* hi = iy + 1 < ny ? mid + wpr : nullptr;
+    std::uint64_t* o = out + static_cast<std::size_t>(iy) * wpr;
+    for (int k = 0; k < wpr; ++k)
+    {
+      o[k] = mid[k] | (lo ? lo[k] : 0) | (hi ? hi[k] : 0);
+    }
+  }
+}
+
 std::uint64_t doubleBits(double value)
 {
   std::uint64_t bits = 0;
@@ -218,19 +237,7 @@ void VoxelSet::dilateInto(VoxelSet& out) const
   std::vector<std::uint64_t> along_x(slice);
   std::vector<std::uint64_t> ring(3 * slice);
   auto planar = [&](int it, std::uint64_t* dst) {
-    dilateAlongX(words_.data() + static_cast<std::size_t>(it) * slice, along_x.data(), static_cast<std::size_t>(ny_),
-                 wpr, tail_mask);
-    for (int iy = 0; iy < ny_; ++iy)
-    {
-      const std::uint64_t* mid = along_x.data() + static_cast<std::size_t>(iy) * wpr;
-      const std::uint64_t* lo = iy > 0 ? mid - wpr : nullptr;
-      const std::uint64_t* hi = iy + 1 < ny_ ? mid + wpr : nullptr;
-      std::uint64_t* o = dst + static_cast<std::size_t>(iy) * wpr;
-      for (int k = 0; k < wpr; ++k)
-      {
-        o[k] = mid[k] | (lo ? lo[k] : 0) | (hi ? hi[k] : 0);
-      }
-    }
+    dilateSliceInPlane(words_.data() + static_cast<std::size_t>(it) * slice, along_x.data(), dst, ny_, wpr, tail_mask);
   };
   std::uint64_t* prev = ring.data();
   std::uint64_t* mid = prev + slice;

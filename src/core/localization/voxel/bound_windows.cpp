@@ -72,12 +72,14 @@ void alongTheta(const std::vector<float>& src, int nt, int m, bool theta_min, Un
   }
 }
 
-/// Min (lower) or max over 2 x 2 padded cells: window (wx, wy) = cells (wx .. wx + 1, wy .. wy + 1).
-UninitialisedVector<float> positionWindows(const UninitialisedVector<float>& along, const GridSpec& spec, bool lower)
+/// Min (lower) or max over 2 x 2 padded cells: window (wx, wy) = cells (wx .. wx + 1, wy .. wy + 1),
+/// in @p steps (lower bounds rounded down, upper ones up).
+UninitialisedVector<std::uint16_t> positionWindows(const UninitialisedVector<float>& along, const GridSpec& spec,
+                                                   bool lower, const RangeSteps& steps)
 {
   const int pnx = spec.nx + 1;
   const std::size_t pslice = static_cast<std::size_t>(pnx) * (spec.ny + 1);
-  UninitialisedVector<float> result(spec.voxelCount());  // every entry written below
+  UninitialisedVector<std::uint16_t> result(spec.voxelCount());  // every entry written below
 #pragma omp parallel for schedule(static)
   for (int t = 0; t < spec.nt; ++t)
   {
@@ -85,11 +87,11 @@ UninitialisedVector<float> positionWindows(const UninitialisedVector<float>& alo
     {
       const float* r0 = along.data() + t * pslice + static_cast<std::size_t>(wy) * pnx;
       const float* r1 = r0 + pnx;
-      float* o = result.data() + spec.index(0, wy, t);
+      std::uint16_t* o = result.data() + spec.index(0, wy, t);
       for (int wx = 0; wx < spec.nx; ++wx)
       {
-        o[wx] = lower ? std::min({ r0[wx], r0[wx + 1], r1[wx], r1[wx + 1] }) :
-                        std::max({ r0[wx], r0[wx + 1], r1[wx], r1[wx + 1] });
+        o[wx] = lower ? steps.down(std::min({ r0[wx], r0[wx + 1], r1[wx], r1[wx + 1] })) :
+                        steps.up(std::max({ r0[wx], r0[wx + 1], r1[wx], r1[wx + 1] }));
       }
     }
   }
@@ -97,8 +99,25 @@ UninitialisedVector<float> positionWindows(const UninitialisedVector<float>& alo
 }
 }  // namespace
 
+RangeSteps RangeSteps::covering(double farthest)
+{
+  RangeSteps steps;
+  steps.unit = std::max(1e-4, std::isfinite(farthest) ? farthest / 65000.0 : 1e-4);
+  return steps;
+}
+
 BoundWindows::BoundWindows(CellBounds cells) : cells_(std::move(cells))
-{}
+{
+  double farthest = 0.0;
+  for (const std::vector<float>* bounds : { &cells_.lower(), &cells_.upper() })
+  {
+    for (float b : *bounds)
+    {
+      farthest = std::isfinite(b) ? std::max(farthest, static_cast<double>(b)) : farthest;
+    }
+  }
+  steps_ = RangeSteps::covering(farthest);
+}
 
 void BoundWindows::require(Kind kind, int m)
 {
@@ -107,11 +126,11 @@ void BoundWindows::require(Kind kind, int m)
   {
     const bool lower = kind == Kind::Lower;
     alongTheta(lower ? cells_.lower() : cells_.upper(), cells_.spec().nt, m, kind != Kind::UpperMax, along_);
-    arrays_.emplace(key, positionWindows(along_, cells_.spec(), lower));
+    arrays_.emplace(key, positionWindows(along_, cells_.spec(), lower, steps_));
   }
 }
 
-const UninitialisedVector<float>& BoundWindows::get(Kind kind, int m) const
+const UninitialisedVector<std::uint16_t>& BoundWindows::get(Kind kind, int m) const
 {
   const auto it = arrays_.find(std::make_pair(static_cast<int>(kind), m));
   if (it == arrays_.end())
@@ -126,7 +145,7 @@ std::size_t BoundWindows::memoryBytes() const
   std::size_t total = cells_.memoryBytes() + along_.capacity() * sizeof(float);
   for (const auto& [key, a] : arrays_)
   {
-    total += a.capacity() * sizeof(float);
+    total += a.capacity() * sizeof(std::uint16_t);
   }
   return total;
 }

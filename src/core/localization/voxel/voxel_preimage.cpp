@@ -3,14 +3,7 @@
 #include "fdml_localization/core/localization/voxel/voxel_engine.h"
 
 #include "fdml_localization/core/geometry/cone_cast.h"
-
-#ifdef __SSE2__
-#include <emmintrin.h>
-#endif
-#if defined(__x86_64__) && defined(__GNUC__)
-#include <immintrin.h>
-#define FDML_AVX2_ROWS 1
-#endif
+#include "fdml_localization/core/localization/voxel/row_marks.h"
 
 #include <algorithm>
 #include <cstddef>
@@ -29,79 +22,6 @@ constexpr double kEps = 1e-9;  ///< cells: lattice coordinates are widened by th
 /// about half a cell times the slope difference, so its band is widened by this many cells.
 constexpr double kKinkMargin = 0.5;
 
-#ifdef FDML_AVX2_ROWS
-/// markRow()'s test eight voxels per step from @p ix (a multiple of 8) on, on CPUs with AVX2
-/// (chosen at run time: the build targets any x86-64); returns where it stopped.
-__attribute__((target("avx2"))) int markRowAvx2(const float* rmin_base, const float* rmax_base, std::ptrdiff_t shift,
-                                                int ix, int end, float lo, float hi, std::uint64_t* row)
-{
-  const __m256 vlo = _mm256_set1_ps(lo);
-  const __m256 vhi = _mm256_set1_ps(hi);
-  for (; ix + 8 <= end; ix += 8)
-  {
-    const __m256 below = _mm256_cmp_ps(_mm256_loadu_ps(rmin_base + (ix + shift)), vhi, _CMP_LE_OQ);
-    const __m256 above = _mm256_cmp_ps(_mm256_loadu_ps(rmax_base + (ix + shift)), vlo, _CMP_GE_OQ);
-    row[ix >> 6] |= static_cast<std::uint64_t>(_mm256_movemask_ps(_mm256_and_ps(below, above))) << (ix & 63);
-  }
-  return ix;
-}
-
-/// Whether the CPU has AVX2 (the CPU model is read first: this runs among static initialisers).
-bool haveAvx2()
-{
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2");
-}
-
-const bool kHaveAvx2 = haveAvx2();
-#endif
-
-/// Sets bit ix of @p row for ix in [begin, end) when [rmin[ix + shift], rmax[ix + shift]] meets
-/// [lo, hi] (no_return: when rmax[ix + shift] >= lo); ix + shift >= 0 on that range.
-void markRow(const float* rmin_base, const float* rmax_base, std::ptrdiff_t shift, int begin, int end, float lo,
-             float hi, bool no_return, std::uint64_t* row)
-{
-  // Shifted views, formed only for the indices read (no pointer before an array).
-  auto rmin = [&](int ix) { return rmin_base + (ix + shift); };
-  auto rmax = [&](int ix) { return rmax_base + (ix + shift); };
-  auto scalar = [&](int ix) {
-    const bool in = no_return ? *rmax(ix) >= lo : (*rmin(ix) <= hi && *rmax(ix) >= lo);
-    row[ix >> 6] |= static_cast<std::uint64_t>(in) << (ix & 63);
-  };
-  int ix = begin;
-#ifdef __SSE2__
-  const float top = no_return ? std::numeric_limits<float>::infinity() : hi;
-#ifdef FDML_AVX2_ROWS
-  if (kHaveAvx2)
-  {
-    for (; ix < end && (ix & 7) != 0; ++ix)
-    {
-      scalar(ix);
-    }
-    // Eight voxels per step; an aligned group of eight never straddles two words.
-    ix = markRowAvx2(rmin_base, rmax_base, shift, ix, end, lo, top, row);
-  }
-#endif
-  for (; ix < end && (ix & 3) != 0; ++ix)
-  {
-    scalar(ix);
-  }
-  // Four voxels per step; an aligned group of four never straddles two words.
-  const __m128 vlo = _mm_set1_ps(lo);
-  const __m128 vhi = _mm_set1_ps(top);
-  for (; ix + 4 <= end; ix += 4)
-  {
-    const __m128 below = _mm_cmple_ps(_mm_loadu_ps(rmin(ix)), vhi);
-    const __m128 in = _mm_and_ps(below, _mm_cmpge_ps(_mm_loadu_ps(rmax(ix)), vlo));
-    row[ix >> 6] |= static_cast<std::uint64_t>(_mm_movemask_ps(in)) << (ix & 63);
-  }
-#endif
-  for (; ix < end; ++ix)
-  {
-    scalar(ix);
-  }
-}
-
 /// The window arrays one slice of one reading reads, at its heading cells; x and y windows of two
 /// cells start at dx0 + k (k < nwx) and dy0 + k relative to the voxel; window index = cell + 1.
 struct SliceWindows
@@ -110,18 +30,18 @@ struct SliceWindows
   int nwx = 0;
   int dy0 = 0;
   int nwy = 0;
-  const float* lower = nullptr;
-  const float* upper = nullptr;
-  const float* inner = nullptr;  ///< cone readings only
+  const std::uint16_t* lower = nullptr;  ///< in range steps (RangeSteps), as the others
+  const std::uint16_t* upper = nullptr;
+  const std::uint16_t* inner = nullptr;  ///< cone readings only
 };
 
 struct RowBuffers
 {
   explicit RowBuffers(int nx) : lo(nx), hi(nx), in(nx)
   {}
-  std::vector<float> lo;
-  std::vector<float> hi;
-  std::vector<float> in;
+  std::vector<std::uint16_t> lo;
+  std::vector<std::uint16_t> hi;
+  std::vector<std::uint16_t> in;
 };
 
 /// Marks row iy: the bounds over the slice's windows (min of the lower, max of the upper bounds,
@@ -145,10 +65,11 @@ void fillRow(const GridSpec& spec, const SliceWindows& w, const Plan& plan, int 
     }
     return;
   }
-  const float inf = std::numeric_limits<float>::infinity();
+  // The steps' ends stand for -inf and +inf (the identities of max and min).
+  const std::uint16_t inf = RangeSteps::kLast;
   std::fill(rows.lo.begin(), rows.lo.end(), inf);
-  std::fill(rows.hi.begin(), rows.hi.end(), -inf);
-  std::fill(rows.in.begin(), rows.in.end(), w.inner ? -inf : inf);
+  std::fill(rows.hi.begin(), rows.hi.end(), 0);
+  std::fill(rows.in.begin(), rows.in.end(), w.inner ? 0 : inf);
   for (int ky = 0; ky < w.nwy; ++ky)
   {
     const int wy = iy + w.dy0 + ky + 1;
@@ -232,8 +153,9 @@ bool VoxelEngine::preimagePlan(const Reading& reading, PreimagePlan& plan) const
   const double tau = options_.range_tolerance;
   const bool no_return = !std::isfinite(reading.range);
   plan.no_return = no_return;
-  plan.lo = roundDown(no_return ? reading.max_range - tau : reading.range - tau);
-  plan.hi = roundUp(no_return ? kInf : reading.range + tau);
+  // The band's bottom rounded up and its top down, as the windows' steps are (RangeSteps).
+  plan.lo = windows_.steps().up(roundDown(no_return ? reading.max_range - tau : reading.range - tau));
+  plan.hi = windows_.steps().down(roundUp(no_return ? kInf : reading.range + tau));
   if (!std::isfinite(reading.offset.x) || !std::isfinite(reading.offset.y) || !std::isfinite(reading.offset.theta))
   {
     return false;

@@ -133,8 +133,8 @@ private:
   /// What the preimage test of one reading reads: the band and the heading windows.
   struct PreimagePlan
   {
-    float lo = 0.0f;  ///< d - tau (no return: max_range - tau) [m]
-    float hi = 0.0f;  ///< d + tau [m]
+    std::uint16_t lo = 0;  ///< d - tau (no return: max_range - tau), in the windows' RangeSteps
+    std::uint16_t hi = 0;  ///< d + tau, in the windows' RangeSteps
     bool no_return = false;
     ThetaWindow ray;    ///< the cells the sensor headings cover
     ThetaWindow lower;  ///< the cells any ray of a cone reading may point in

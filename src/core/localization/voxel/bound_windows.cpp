@@ -99,13 +99,6 @@ UninitialisedVector<std::uint16_t> positionWindows(const UninitialisedVector<flo
 }
 }  // namespace
 
-RangeSteps RangeSteps::covering(double farthest)
-{
-  RangeSteps steps;
-  steps.unit = std::max(1e-4, std::isfinite(farthest) ? farthest / 65000.0 : 1e-4);
-  return steps;
-}
-
 BoundWindows::BoundWindows(CellBounds cells) : cells_(std::move(cells))
 {
   double farthest = 0.0;

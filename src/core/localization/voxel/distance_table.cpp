@@ -100,8 +100,14 @@ void DistanceTable::computeBlocks()
       }
     }
   }
-  block_min_.assign(values_.size(), inf);
-  block_max_.assign(values_.size(), -inf);
+  double farthest = 0.0;
+  for (float x : values_)
+  {
+    farthest = std::isfinite(x) ? std::max(farthest, static_cast<double>(x)) : farthest;
+  }
+  steps_ = RangeSteps::covering(farthest);
+  block_min_.resize(values_.size());
+  block_max_.resize(values_.size());
 #pragma omp parallel for schedule(static)
   for (int it = 0; it < nt; ++it)
   {
@@ -109,15 +115,15 @@ void DistanceTable::computeBlocks()
     const std::size_t b = ((it + 1) % nt) * slice;
     for (std::size_t k = 0; k < slice; ++k)
     {
-      block_min_[a + k] = std::min(lo2[a + k], lo2[b + k]);
-      block_max_[a + k] = std::max(hi2[a + k], hi2[b + k]);
+      block_min_[a + k] = steps_.down(std::min(lo2[a + k], lo2[b + k]));
+      block_max_[a + k] = steps_.up(std::max(hi2[a + k], hi2[b + k]));
     }
   }
 }
 
 std::size_t DistanceTable::memoryBytes() const
 {
-  return (values_.capacity() + block_min_.capacity() + block_max_.capacity()) * sizeof(float);
+  return values_.capacity() * sizeof(float) + (block_min_.capacity() + block_max_.capacity()) * sizeof(std::uint16_t);
 }
 
 }  // namespace core

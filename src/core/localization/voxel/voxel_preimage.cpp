@@ -138,12 +138,15 @@ void VoxelEngine::fillSampleSlice(const Reading& reading, int it, VoxelSet& set)
   const int x_end = std::min(nx, nx - 1 - sx);
   const int y_begin = std::max(0, -sy);
   const int y_end = std::min(ny, ny - 1 - sy);
-  const float* bmin = table_.blockMin().data();
-  const float* bmax = table_.blockMax().data();
+  const std::uint16_t* bmin = table_.blockMin().data();
+  const std::uint16_t* bmax = table_.blockMax().data();
+  // The band's bottom rounded up and its top down, as the blocks' steps are.
+  const std::uint16_t lo_steps = table_.steps().up(lo);
+  const std::uint16_t hi_steps = table_.steps().down(hi);
   for (int iy = y_begin; iy < y_end; ++iy)
   {
     const std::ptrdiff_t base = static_cast<std::ptrdiff_t>(t0 * slice + static_cast<std::size_t>(iy + sy) * nx) + sx;
-    markRow(bmin, bmax, base, x_begin, x_end, lo, hi, no_return, set.row(iy, it));
+    markRow(bmin, bmax, base, x_begin, x_end, lo_steps, hi_steps, no_return, set.row(iy, it));
   }
 }
 

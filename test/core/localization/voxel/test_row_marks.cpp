@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 #include <random>
 #include <vector>
@@ -86,24 +87,39 @@ TEST(RowMarks, RangeStepsKeepEveryVoxelTheFloatTestKeeps)
   for (int trial = 0; trial < 200000; ++trial)
   {
     // Lower and upper bounds, a band; near-ties drawn often (within a step).
-    const float l = static_cast<float>(range(rng));
-    const float u = trial % 7 == 0 ? std::numeric_limits<float>::infinity() : static_cast<float>(range(rng));
+    const float inf = std::numeric_limits<float>::infinity();
+    const float l = trial % 11 == 0 ? inf : static_cast<float>(range(rng));
+    const float u = trial % 7 == 0 ? inf : trial % 13 == 0 ? -inf : static_cast<float>(range(rng));
     const float lo = trial % 3 == 0 ? u - static_cast<float>(1e-4 * (rng() % 10)) : static_cast<float>(range(rng));
     const float hi = trial % 3 == 1 ? l + static_cast<float>(1e-4 * (rng() % 10)) : static_cast<float>(range(rng));
-    if (l <= hi && u >= lo)
+    if (l <= hi && u >= lo)  // every voxel the float test keeps ...
     {
       ++kept;
       ASSERT_LE(steps.down(l), steps.down(hi)) << l << " " << hi;
       ASSERT_GE(steps.up(u), steps.up(lo)) << u << " " << lo;
     }
+    // An infinite bound the float test rejects against a finite band stays rejected.
+    if (l == inf && std::isfinite(hi))
+    {
+      EXPECT_GT(steps.down(l), steps.down(hi));
+    }
+    if (u == -inf && std::isfinite(lo))
+    {
+      EXPECT_LT(steps.up(u), steps.up(lo));
+    }
   }
   EXPECT_GT(kept, 20000);
-  // Ends and NaN: the step that keeps a voxel.
+  // NaN takes the step that keeps a voxel; the infinite ends keep steps of their own, so that
+  // a bound of +inf (-inf) still fails against every finite band's top (bottom).
+  const double inf = std::numeric_limits<double>::infinity();
   EXPECT_EQ(steps.down(-3.0), 0);
   EXPECT_EQ(steps.down(std::numeric_limits<double>::quiet_NaN()), 0);
-  EXPECT_EQ(steps.up(std::numeric_limits<double>::infinity()), RangeSteps::kLast);
   EXPECT_EQ(steps.up(std::numeric_limits<double>::quiet_NaN()), RangeSteps::kLast);
-  EXPECT_EQ(steps.down(1e9), RangeSteps::kLast);
+  EXPECT_EQ(steps.down(inf), RangeSteps::kLast);
+  EXPECT_EQ(steps.down(1e9), RangeSteps::kLast - 1);
+  EXPECT_EQ(steps.up(-inf), 0);
+  EXPECT_EQ(steps.up(-3.0), 1);
+  EXPECT_EQ(steps.up(inf), RangeSteps::kLast);
   EXPECT_LE(steps.unit, 35.0 / 65000.0 + 1e-12);
 }
 

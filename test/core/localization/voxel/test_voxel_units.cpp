@@ -163,8 +163,8 @@ TEST(DistanceTable, SamplesAndBlocksMatchBruteForce)
       }
     }
     const std::size_t v = spec.index(ix, iy, it);
-    EXPECT_EQ(table.blockMin()[v], lo);
-    EXPECT_EQ(table.blockMax()[v], hi);
+    EXPECT_EQ(table.blockMin()[v], table.steps().down(lo));
+    EXPECT_EQ(table.blockMax()[v], table.steps().up(hi));
   }
 }
 

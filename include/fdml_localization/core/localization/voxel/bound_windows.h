@@ -8,9 +8,9 @@
 #pragma once
 
 #include "fdml_localization/core/localization/voxel/cell_bounds.h"
+#include "fdml_localization/core/localization/voxel/range_steps.h"
 #include "fdml_localization/core/util/uninitialised.h"
 
-#include <cmath>
 #include <cstdint>
 #include <map>
 #include <utility>
@@ -20,35 +20,6 @@ namespace fdml_localization
 {
 namespace core
 {
-/**
- * @brief Ranges [m] in 16-bit steps of unit metres, rounded so that each comparison of the
- *        preimage test keeps its outcome or becomes true (the test stays conservative): lower
- *        bounds and the top of a reading's band rounded down, upper bounds and the bottom of the
- *        band rounded up. Both roundings are monotone, so they commute with the minima and
- *        maxima over the windows. Values beyond the last step take it; NaN takes the end that
- *        keeps a voxel.
- */
-struct RangeSteps
-{
-  static constexpr std::uint16_t kLast = 65535;
-  double unit = 1e-3;  ///< [m]
-
-  /// For the bounds up to @p farthest [m] (the largest finite one): steps of about 1 / 65000 of
-  /// it, at least 0.1 mm.
-  static RangeSteps covering(double farthest);
-
-  std::uint16_t down(double value) const
-  {
-    const double q = std::floor(value / unit);
-    return !(q > 0.0) ? 0 : q >= kLast ? kLast : static_cast<std::uint16_t>(q);
-  }
-  std::uint16_t up(double value) const
-  {
-    const double q = std::ceil(value / unit);
-    return !(q < kLast) ? kLast : q <= 0.0 ? 0 : static_cast<std::uint16_t>(q);
-  }
-};
-
 /**
  * Arrays shaped like the voxel grid: entry (wx, wy, jt) covers the cells jx in {wx - 1, wx},
  * jy in {wy - 1, wy} and the m heading cells jt .. jt + m - 1.

@@ -2,13 +2,16 @@
  * @file distance_table.h
  * @brief The distance table of the voxel engine: h (the map's exact ray-cast distance)
  *        sampled at every voxel centre, plus the min / max of h over every 2 x 2 x 2 block
- *        of samples, which turns the preimage's sign-change test into two comparisons.
+ *        of samples (in range steps), which turns the preimage's sign-change test into two
+ *        comparisons.
  */
 #pragma once
 
 #include "fdml_localization/core/geometry/ray_caster.h"
+#include "fdml_localization/core/localization/voxel/range_steps.h"
 #include "fdml_localization/core/localization/voxel/voxel_grid.h"
 
+#include <cstdint>
 #include <vector>
 
 namespace fdml_localization
@@ -49,16 +52,22 @@ public:
 
   /**
    * @brief Min and max of the valid samples of the block (ix..ix+1, iy..iy+1, it..it+1), theta
-   *        periodic, stored at index(ix, iy, it) [m]. A block with no valid sample (or that
-   *        runs off the grid in x or y) has min = +inf and max = -inf.
+   *        periodic, stored at index(ix, iy, it), in steps() (the min rounded down, the max up).
+   *        A block with no valid sample (or that runs off the grid in x or y) has min = +inf
+   *        and max = -inf (their steps).
    */
-  const std::vector<float>& blockMin() const
+  const std::vector<std::uint16_t>& blockMin() const
   {
     return block_min_;
   }
-  const std::vector<float>& blockMax() const
+  const std::vector<std::uint16_t>& blockMax() const
   {
     return block_max_;
+  }
+  /// The steps of the block arrays: about 1 / 65000 of the farthest sample.
+  const RangeSteps& steps() const
+  {
+    return steps_;
   }
 
   /// Bytes held by the table and its block arrays.
@@ -69,8 +78,9 @@ private:
 
   GridSpec spec_;
   std::vector<float> values_;
-  std::vector<float> block_min_;
-  std::vector<float> block_max_;
+  RangeSteps steps_;
+  std::vector<std::uint16_t> block_min_;
+  std::vector<std::uint16_t> block_max_;
 };
 
 }  // namespace core

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <stdexcept>
 
 namespace fdml_localization
 {
@@ -52,7 +53,12 @@ LevelMasks::LevelMasks(const GridSpec& spec, const std::vector<std::uint8_t>& co
   , reached_(level_bits_.size(), 0)
   , queued_(built_.size(), 0)
   , runs_(words_, 0)
-{}
+{
+  if (count.size() != spec.voxelCount())
+  {
+    throw std::invalid_argument("LevelMasks: the count field does not match the grid");
+  }
+}
 
 const LevelMasks::Word* LevelMasks::levelOf(std::size_t row)
 {

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <random>
 #include <set>
+#include <stdexcept>
 
 namespace fdml_localization
 {
@@ -150,6 +151,7 @@ TEST(LevelMasks, DiagonalNeighboursAcrossWords)
     count[v] = 4;
   }
   EXPECT_EQ(componentSizes(spec, count, 3, voxels), std::vector<std::size_t>(voxels.size(), 2u));
+  EXPECT_THROW(LevelMasks(spec, std::vector<std::uint8_t>(3, 4), 3), std::invalid_argument);  // not this grid's
   const std::vector<std::size_t> brute = bruteSizes(spec, count, 3);
   for (std::size_t v : voxels)
   {

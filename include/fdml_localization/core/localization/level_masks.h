@@ -21,7 +21,8 @@ namespace core
 class LevelMasks
 {
 public:
-  /// @p spec and @p count must outlive this.
+  /// @p spec and @p count must outlive this; throws std::invalid_argument when @p count is not
+  /// one value per voxel of @p spec.
   LevelMasks(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level);
 
   /// For each of @p voxels, the number of voxels of its connected component (0 for a voxel below

@@ -70,6 +70,7 @@ void certify(const MapRayCaster& map, const std::vector<Reading>& readings, doub
       regions.count - c.regions_covered - static_cast<int>(std::count(reachable.begin(), reachable.end(), 1));
   c.complete = c.regions_covered + c.regions_excluded == regions.count;
 }
+
 /// The voxels of @p spec whose (closed) box holds one of @p candidates' poses, in no order.
 std::vector<std::size_t> voxelsHolding(const GridSpec& spec, const std::vector<Candidate>& candidates)
 {

@@ -99,18 +99,9 @@ UninitialisedVector<std::uint16_t> positionWindows(const UninitialisedVector<flo
 }
 }  // namespace
 
-BoundWindows::BoundWindows(CellBounds cells) : cells_(std::move(cells))
-{
-  double farthest = 0.0;
-  for (const std::vector<float>* bounds : { &cells_.lower(), &cells_.upper() })
-  {
-    for (float b : *bounds)
-    {
-      farthest = std::isfinite(b) ? std::max(farthest, static_cast<double>(b)) : farthest;
-    }
-  }
-  steps_ = RangeSteps::covering(farthest);
-}
+BoundWindows::BoundWindows(CellBounds cells)
+  : cells_(std::move(cells)), steps_(RangeSteps::covering({ &cells_.lower(), &cells_.upper() }))
+{}
 
 void BoundWindows::require(Kind kind, int m)
 {

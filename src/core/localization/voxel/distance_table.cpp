@@ -100,12 +100,7 @@ void DistanceTable::computeBlocks()
       }
     }
   }
-  double farthest = 0.0;
-  for (float x : values_)
-  {
-    farthest = std::isfinite(x) ? std::max(farthest, static_cast<double>(x)) : farthest;
-  }
-  steps_ = RangeSteps::covering(farthest);
+  steps_ = RangeSteps::covering({ &values_ });
   block_min_.resize(values_.size());
   block_max_.resize(values_.size());
 #pragma omp parallel for schedule(static)

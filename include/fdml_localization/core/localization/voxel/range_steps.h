@@ -8,7 +8,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <initializer_list>
 #include <limits>
+#include <vector>
 
 namespace fdml_localization
 {
@@ -35,6 +37,20 @@ struct RangeSteps
     RangeSteps steps;
     steps.unit = std::max(1e-4, std::isfinite(farthest) ? farthest / 65000.0 : 1e-4);
     return steps;
+  }
+
+  /// covering() the largest finite value of @p arrays [m] (infinities and NaN ignored).
+  static RangeSteps covering(std::initializer_list<const std::vector<float>*> arrays)
+  {
+    double farthest = 0.0;
+    for (const std::vector<float>* values : arrays)
+    {
+      for (float x : *values)
+      {
+        farthest = std::isfinite(x) ? std::max(farthest, static_cast<double>(x)) : farthest;
+      }
+    }
+    return covering(farthest);
   }
 
   std::uint16_t down(double value) const

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
 
 namespace fdml_localization
@@ -225,19 +224,11 @@ std::vector<VoxelCluster> connectedComponents(const GridSpec& spec, const std::v
   const Neighbours neighbours(spec);
   std::vector<std::size_t> queue;
   auto inside = [&](std::size_t u) { return count[u] >= level; };
-  const bool words = level >= 1 && level <= 128;
-  for (std::size_t v = 0; v < count.size(); ++v)
-  {
-    std::uint64_t word = 0;
-    if (words && v % 8 == 0 && v + 8 <= count.size() &&
-        (std::memcpy(&word, count.data() + v, 8), !anyByteAtLeast(word, static_cast<unsigned>(level))))
+  // Every voxel reaching the level, ascending; a component starts at its first voxel.
+  forEachVoxelIn(count, 0, count.size(), static_cast<unsigned>(std::clamp(level, 0, 256)), 255u, [&](std::size_t v) {
+    if (visited.test(v))
     {
-      v += 7;  // none of these eight reaches the level
-      continue;
-    }
-    if (count[v] < level || visited.test(v))
-    {
-      continue;
+      return;
     }
     VoxelCluster cluster;
     flood(neighbours, v, visited, queue, inside,
@@ -245,7 +236,7 @@ std::vector<VoxelCluster> connectedComponents(const GridSpec& spec, const std::v
     cluster.voxels = queue;
     computeCentroid(spec, cluster);
     clusters.push_back(std::move(cluster));
-  }
+  });
   std::stable_sort(clusters.begin(), clusters.end(), [](const VoxelCluster& a, const VoxelCluster& b) {
     return a.peak_count != b.peak_count ? a.peak_count > b.peak_count : a.voxels.size() > b.voxels.size();
   });

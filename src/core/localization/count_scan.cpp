@@ -31,49 +31,6 @@ bool anyByteEqual(std::uint64_t word, unsigned value)
   return ((x - kOnes) & ~x & kTops) != 0;
 }
 
-namespace
-{
-/// Calls @p fn(v) for every voxel v in [first, end) (ascending) whose count lies in [lo, hi],
-/// lo >= 1, skipping eight voxels at a time that hold none (hi == lo: none equal to it).
-template <typename Fn>
-void forEachVoxelIn(const std::vector<std::uint8_t>& count, std::size_t first, std::size_t end, unsigned lo,
-                    unsigned hi, Fn&& fn)
-{
-  std::size_t v = first;
-  end = std::min(end, count.size());
-  if (lo > 255u || lo > hi)
-  {
-    return;
-  }
-  if (lo <= 128u)
-  {
-    for (; v + 8 <= end; v += 8)
-    {
-      std::uint64_t word = 0;
-      std::memcpy(&word, count.data() + v, 8);
-      if (lo == hi ? !anyByteEqual(word, lo) : !anyByteAtLeast(word, lo))
-      {
-        continue;
-      }
-      for (std::size_t j = v; j < v + 8; ++j)
-      {
-        if (count[j] >= lo && count[j] <= hi)
-        {
-          fn(j);
-        }
-      }
-    }
-  }
-  for (; v < end; ++v)
-  {
-    if (count[v] >= lo && count[v] <= hi)
-    {
-      fn(v);
-    }
-  }
-}
-}  // namespace
-
 std::vector<std::vector<std::size_t>> voxelsByCount(const std::vector<std::uint8_t>& count, int min_level,
                                                     int max_level)
 {

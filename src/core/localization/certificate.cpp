@@ -30,15 +30,20 @@ struct BoundRegions
   std::vector<int> region;  ///< per box
 };
 
-/// Fills @p result.certificate: covered regions hold a candidate's pose; the others are
-/// excluded when no sub-box of theirs may reach the bound.
-void certify(const MapRayCaster& map, const std::vector<Reading>& readings, double tolerance, int bound,
+/// The readings the best candidate explains (0 without candidates).
+int bestConsensus(const MapRayCaster& map, const std::vector<Reading>& readings, double tolerance, const Result& result)
+{
+  return result.candidates.empty() ? 0 : consensusWithin(map, result.candidates.front().pose, readings, tolerance);
+}
+
+/// Fills @p result.certificate (@p best: bestConsensus()): covered regions hold a candidate's
+/// pose; the others are excluded when no sub-box of theirs may reach the bound.
+void certify(const MapRayCaster& map, const std::vector<Reading>& readings, double tolerance, int bound, int best,
              const BoundRegions& regions, bool unresolved, Result& result)
 {
   Certificate& c = result.certificate;
   c.max_consensus_bound = bound;
-  c.best_consensus =
-      result.candidates.empty() ? 0 : consensusWithin(map, result.candidates.front().pose, readings, tolerance);
+  c.best_consensus = best;
   c.regions_at_bound = regions.count;
   std::vector<char> covered(static_cast<std::size_t>(regions.count), 0);
   for (std::size_t b = 0; b < regions.boxes.size(); ++b)
@@ -132,15 +137,15 @@ void certifyAdaptive(const MapRayCaster& map, const std::vector<Reading>& readin
       regions.region.push_back(labels[i]);
     }
   }
-  certify(map, readings, tolerance, bound, regions, search.unresolvedReaches(bound), result);
+  certify(map, readings, tolerance, bound, bestConsensus(map, readings, tolerance, result), regions,
+          search.unresolvedReaches(bound), result);
 }
 
 void certifyVoxels(const MapRayCaster& map, const std::vector<Reading>& readings, double tolerance,
                    const GridSpec& spec, const std::vector<std::uint8_t>& count, Result& result)
 {
   const int bound = count.empty() ? -1 : *std::max_element(count.begin(), count.end());
-  const int best =
-      result.candidates.empty() ? 0 : consensusWithin(map, result.candidates.front().pose, readings, tolerance);
+  const int best = bestConsensus(map, readings, tolerance, result);
   if (bound > 0 && best != bound)
   {
     // Incomplete whatever the regions hold (certify()): only how many there are and how many
@@ -168,7 +173,7 @@ void certifyVoxels(const MapRayCaster& map, const std::vector<Reading>& readings
       }
     }
   }
-  certify(map, readings, tolerance, bound, regions, false, result);
+  certify(map, readings, tolerance, bound, best, regions, false, result);
 }
 
 }  // namespace core

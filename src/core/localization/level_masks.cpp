@@ -122,6 +122,7 @@ std::size_t LevelMasks::flood(std::size_t row, int x)
 {
   std::vector<Word> seed(words_, 0);
   seed[static_cast<std::size_t>(x) >> 6] = Word{ 1 } << (x & 63);
+  ++floods_;
   std::size_t voxels = fill(row, seed.data());
   const std::size_t ny = static_cast<std::size_t>(spec_.ny);
   std::vector<Word> spread(words_);
@@ -183,12 +184,11 @@ std::size_t LevelMasks::floodEach(const std::vector<std::size_t>& voxels, std::v
       open.push_back(k);
     }
   }
-  std::size_t floods = 0;
+  const std::size_t before = floods_;
   while (!open.empty())
   {
     const std::size_t v = voxels[open.front()];
     const std::size_t size = flood(v / nx, static_cast<int>(v % nx));
-    ++floods;
     const auto rest = std::partition(open.begin(), open.end(), [&](std::size_t k) { return !reached(voxels[k]); });
     for (auto it = rest; it != open.end(); ++it)
     {
@@ -196,8 +196,7 @@ std::size_t LevelMasks::floodEach(const std::vector<std::size_t>& voxels, std::v
     }
     open.erase(rest, open.end());
   }
-  floods_ += floods;
-  return floods;
+  return floods_ - before;
 }
 
 std::vector<std::size_t> LevelMasks::componentSizes(const std::vector<std::size_t>& voxels)
@@ -220,7 +219,6 @@ std::size_t LevelMasks::componentCount(const std::vector<std::size_t>& voxels, s
            open = levelOf(row)[w] & ~reached_[row * words_ + w])
       {
         flood(row, static_cast<int>(64 * w) + __builtin_ctzll(open));
-        ++floods_;
       }
     }
   }

@@ -6,7 +6,7 @@
 #include "fdml_localization/core/localization/robust_search.h"
 #include "fdml_localization/core/localization/seed_refiner.h"
 
-#include <omp.h>
+#include "fdml_localization/core/util/threads.h"
 
 #include <algorithm>
 #include <cmath>
@@ -295,7 +295,7 @@ void settleInNearBasins(const MapRayCaster& map, const std::vector<Reading>& rea
   {
     ++tied;
   }
-  const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+  const int threads = threadsFor(options.threads);
   std::vector<std::vector<Candidate>> elsewhere(static_cast<std::size_t>(tied));
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (tied >= 2)
   for (long j = 0; j < tied; ++j)

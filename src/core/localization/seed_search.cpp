@@ -4,7 +4,7 @@
 #include "fdml_localization/core/localization/seed_refiner.h"
 #include "fdml_localization/core/util/stopwatch.h"
 
-#include <omp.h>
+#include "fdml_localization/core/util/threads.h"
 
 #include <algorithm>
 #include <chrono>
@@ -295,7 +295,7 @@ SearchContext makeContext(const MapRayCaster& map, const std::vector<Reading>& r
                           const LocalizerOptions& options, const SeedScale& scale)
 {
   SearchContext ctx{ map, readings, scale, RefinementSettings(), 0.0, 1, Deadline(options.deadline) };
-  ctx.threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+  ctx.threads = threadsFor(options.threads);
   ctx.settings.agreement_tolerance = options.agreement_tolerance;
   ctx.settings.robust_scale = seedGate(readings, options, scale) / 3.0;
   ctx.settings.noise_sigma = std::max(options.range_tolerance / std::sqrt(3.0), 1e-4);

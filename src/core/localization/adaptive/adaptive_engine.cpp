@@ -11,7 +11,7 @@
 #include "fdml_localization/core/localization/seed_search.h"
 #include "fdml_localization/core/util/stopwatch.h"
 
-#include <omp.h>
+#include "fdml_localization/core/util/threads.h"
 
 #include <algorithm>
 #include <chrono>
@@ -201,7 +201,7 @@ void AdaptiveEngine::localizeFixed(AdaptiveSearch& search, const std::vector<Rea
                                    Result& result)
 {
   const std::int64_t theta_cells = thetaCells(cell_theta_);
-  const int threads = options_.threads > 0 ? options_.threads : omp_get_max_threads();
+  const int threads = threadsFor(options_.threads);
   auto stage = std::chrono::steady_clock::now();
   const AdaptiveSearchResult& found = search.run(level);
   result.times.preimages += secondsSince(stage);
@@ -232,7 +232,7 @@ void AdaptiveEngine::localizeFixed(AdaptiveSearch& search, const std::vector<Rea
 
 void AdaptiveEngine::localizeRobust(AdaptiveSearch& search, const std::vector<Reading>& readings, Result& result)
 {
-  const int threads = options_.threads > 0 ? options_.threads : omp_get_max_threads();
+  const int threads = threadsFor(options_.threads);
   const SeedScale scale{ cell_xy_, cell_theta_ };
   // A plateau's leaves are ranked with the shared search's loose agreement band.
   LeafSeeds seeds(*map_, search, readings, cell_xy_, cell_theta_, seedGate(readings, options_, scale), threads,

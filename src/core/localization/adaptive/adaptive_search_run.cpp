@@ -1,7 +1,7 @@
 // The resumable level-by-level box search (AdaptiveSearch).
 #include "fdml_localization/core/localization/adaptive/adaptive_search.h"
 
-#include <omp.h>
+#include "fdml_localization/core/util/threads.h"
 
 #include <algorithm>
 #include <chrono>
@@ -202,7 +202,7 @@ bool AdaptiveSearch::resumeSetAside(int level, int min_count, std::vector<Node>&
 
 void AdaptiveSearch::testLevel(int level, int min_count, std::vector<Node>& current, std::vector<Node>& survivors)
 {
-  const int threads = options_.threads > 0 ? options_.threads : omp_get_max_threads();
+  const int threads = threadsFor(options_.threads);
   std::vector<Outcome> outcome(current.size(), Outcome::Pruned);
   const long size = static_cast<long>(current.size());
 #pragma omp parallel for schedule(dynamic, 64) num_threads(threads) if (size > options_.parallel_threshold)

@@ -1,6 +1,6 @@
 #include "fdml_localization/core/localization/voxel/distance_table.h"
 
-#include <omp.h>
+#include "fdml_localization/core/util/threads.h"
 
 #include <cmath>
 #include <limits>
@@ -11,14 +11,6 @@ namespace fdml_localization
 {
 namespace core
 {
-namespace
-{
-int threadCount(int threads)
-{
-  return threads > 0 ? threads : omp_get_max_threads();
-}
-}  // namespace
-
 DistanceTable::DistanceTable(const GridSpec& spec, std::vector<float> values) : spec_(spec), values_(std::move(values))
 {
   if (values_.size() != spec_.voxelCount())
@@ -43,7 +35,7 @@ DistanceTable DistanceTable::build(const MapRayCaster& map, const GridSpec& spec
   }
   const std::size_t slice = static_cast<std::size_t>(nx) * ny;
   const long cells = static_cast<long>(slice);
-#pragma omp parallel for schedule(dynamic, 16) num_threads(threadCount(threads))
+#pragma omp parallel for schedule(dynamic, 16) num_threads(threadsFor(threads))
   for (long c = 0; c < cells; ++c)
   {
     const int ix = static_cast<int>(c % nx);

@@ -5,7 +5,7 @@
 #include "fdml_localization/core/localization/voxel/box_occupancy.h"
 #include "fdml_localization/core/util/stopwatch.h"
 
-#include <omp.h>
+#include "fdml_localization/core/util/threads.h"
 
 #include <algorithm>
 #include <chrono>
@@ -118,7 +118,7 @@ VoxelEngine::VoxelEngine(std::shared_ptr<const MapRayCaster> map, const Localize
 
 int VoxelEngine::threads() const
 {
-  return options_.threads > 0 ? options_.threads : omp_get_max_threads();
+  return threadsFor(options_.threads);
 }
 
 void VoxelEngine::prepare()

@@ -254,54 +254,23 @@ std::vector<std::size_t> componentSizes(const GridSpec& spec, const std::vector<
   return LevelMasks(spec, count, level).componentSizes(seeds);
 }
 
-std::vector<std::size_t> liftNonMaximalPlateaus(const GridSpec& spec, std::vector<std::uint8_t>& count, int level,
-                                                const std::vector<std::size_t>& above)
+std::vector<std::size_t> liftNonMaximalPlateaus(const GridSpec& spec, std::vector<std::uint8_t>& count, int level)
 {
   std::vector<std::size_t> lifted;
   if (level < 0 || level > 254)
   {
     return lifted;
   }
-  // A voxel lifted is above the level: the count itself marks what the flood has reached.
-  const auto up = static_cast<std::uint8_t>(level + 1);
-  const Neighbours neighbours(spec);
-  auto visit = [&](std::size_t w) {
-    if (count[w] == level)
-    {
-      count[w] = up;
-      lifted.push_back(w);
-    }
-    return true;
-  };
-  for (std::size_t u : above)
+  // Flooded as bit masks: the voxels at the level from those beside a voxel above it.
+  LevelMasks at(spec, count, level, level);
+  LevelMasks higher(spec, count, level + 1);
+  at.floodNeighboursOf(higher);
+  lifted = at.floodedVoxels();
+  for (std::size_t v : lifted)
   {
-    neighbours.until(u, visit);
-  }
-  for (std::size_t head = 0; head < lifted.size(); ++head)
-  {
-    neighbours.until(lifted[head], visit);
+    count[v] = static_cast<std::uint8_t>(level + 1);
   }
   return lifted;
-}
-
-std::vector<std::size_t> withNeighbourBelow(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
-                                            const std::vector<std::size_t>& voxels)
-{
-  const Neighbours neighbours(spec);
-  std::vector<std::size_t> kept;
-  for (std::size_t v : voxels)
-  {
-    bool below = false;
-    neighbours.until(v, [&](std::size_t w) {
-      below = count[w] < level;
-      return !below;
-    });
-    if (below)
-    {
-      kept.push_back(v);
-    }
-  }
-  return kept;
 }
 
 std::vector<VoxelCluster> regionalMaxima(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,

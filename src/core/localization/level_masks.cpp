@@ -43,16 +43,19 @@ std::size_t popcount(Word w)
 }
 }  // namespace
 
-LevelMasks::LevelMasks(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level)
+LevelMasks::LevelMasks(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level, int top)
   : spec_(spec)
   , count_(count)
   , level_(level)
+  , top_(top)
   , words_((static_cast<std::size_t>(std::max(spec.nx, 0)) + 63) / 64)
   , level_bits_(static_cast<std::size_t>(std::max(spec.ny, 0)) * std::max(spec.nt, 0) * words_, 0)
   , built_(static_cast<std::size_t>(std::max(spec.ny, 0)) * std::max(spec.nt, 0), 0)
   , reached_(level_bits_.size(), 0)
   , queued_(built_.size(), 0)
   , runs_(words_, 0)
+  , spread_(words_, 0)
+  , seeds_(words_, 0)
 {
   if (count.size() != spec.voxelCount())
   {
@@ -68,18 +71,20 @@ const LevelMasks::Word* LevelMasks::levelOf(std::size_t row)
     built_[row] = 1;
     const std::uint8_t* c = count_.data() + row * static_cast<std::size_t>(spec_.nx);
     int x = 0;
-    if (level_ >= 1 && level_ <= 128)
+    if (level_ >= 1 && level_ <= 128 && (top_ >= 255 || top_ < 128))
     {
       for (; x + 8 <= spec_.nx; x += 8)  // eight voxels at a time
       {
         std::uint64_t word = 0;
         std::memcpy(&word, c + x, 8);
-        bits[x >> 6] |= static_cast<Word>(bytesAtLeast(word, static_cast<unsigned>(level_))) << (x & 63);
+        unsigned in = bytesAtLeast(word, static_cast<unsigned>(level_));
+        in &= top_ >= 255 ? 0xffu : ~bytesAtLeast(word, static_cast<unsigned>(std::max(top_ + 1, 1)));
+        bits[x >> 6] |= static_cast<Word>(in) << (x & 63);
       }
     }
     for (; x < spec_.nx; ++x)
     {
-      bits[x >> 6] |= static_cast<Word>(c[x] >= level_) << (x & 63);
+      bits[x >> 6] |= static_cast<Word>(c[x] >= level_ && c[x] <= top_) << (x & 63);
     }
   }
   return bits;
@@ -123,44 +128,94 @@ std::size_t LevelMasks::flood(std::size_t row, int x)
   std::vector<Word> seed(words_, 0);
   seed[static_cast<std::size_t>(x) >> 6] = Word{ 1 } << (x & 63);
   ++floods_;
-  std::size_t voxels = fill(row, seed.data());
+  const std::size_t voxels = fill(row, seed.data());
+  return voxels + spread();
+}
+
+template <typename Fn>
+void LevelMasks::forEachRowAround(std::size_t row, bool self, Fn&& fn) const
+{
   const std::size_t ny = static_cast<std::size_t>(spec_.ny);
-  std::vector<Word> spread(words_);
-  std::vector<Word> seeds(words_);
+  const int iy = static_cast<int>(row % ny);
+  const int it = static_cast<int>(row / ny);
+  for (int dt = -1; dt <= 1; ++dt)
+  {
+    const int t = (it + dt + spec_.nt) % spec_.nt;
+    for (int dy = -1; dy <= 1; ++dy)
+    {
+      const int y = iy + dy;
+      const std::size_t next = static_cast<std::size_t>(t) * ny + static_cast<std::size_t>(y);
+      if (y >= 0 && y < spec_.ny && (self || next != row))
+      {
+        fn(next);
+      }
+    }
+  }
+}
+
+std::size_t LevelMasks::spreadFrom(const Word* from, std::size_t row, bool self)
+{
+  // The row's voxels and their neighbours along x.
+  for (std::size_t w = 0; w < words_; ++w)
+  {
+    spread_[w] = from[w] | (from[w] << 1) | (from[w] >> 1) | (w > 0 ? from[w - 1] >> 63 : 0) |
+                 (w + 1 < words_ ? from[w + 1] << 63 : 0);
+  }
+  std::size_t voxels = 0;
+  forEachRowAround(row, self, [&](std::size_t next) {
+    const Word* level = levelOf(next);
+    const Word* reached = reached_.data() + next * words_;
+    Word any = 0;
+    for (std::size_t w = 0; w < words_; ++w)
+    {
+      seeds_[w] = spread_[w] & level[w] & ~reached[w];
+      any |= seeds_[w];
+    }
+    voxels += any != 0 ? fill(next, seeds_.data()) : 0;
+  });
+  return voxels;
+}
+
+std::size_t LevelMasks::spread()
+{
+  std::size_t voxels = 0;
   while (!stack_.empty())
   {
     const std::size_t r = stack_.back();
     stack_.pop_back();
     queued_[r] = 0;
-    // The row's voxels and their neighbours along x.
-    const Word* from = reached_.data() + r * words_;
+    // A row's own runs never touch (a gap lies between them).
+    voxels += spreadFrom(reached_.data() + r * words_, r, false);
+  }
+  return voxels;
+}
+
+std::size_t LevelMasks::floodNeighboursOf(LevelMasks& source)
+{
+  std::size_t voxels = 0;
+  for (std::size_t row = 0; row < built_.size(); ++row)
+  {
+    const Word* from = source.levelOf(row);
+    if (std::any_of(from, from + words_, [](Word w) { return w != 0; }))
+    {
+      voxels += spreadFrom(from, row, true);
+      voxels += spread();
+    }
+  }
+  return voxels;
+}
+
+std::vector<std::size_t> LevelMasks::floodedVoxels() const
+{
+  std::vector<std::size_t> voxels;
+  const std::size_t nx = static_cast<std::size_t>(spec_.nx);
+  for (std::size_t row = 0; row < built_.size(); ++row)
+  {
     for (std::size_t w = 0; w < words_; ++w)
     {
-      spread[w] = from[w] | (from[w] << 1) | (from[w] >> 1) | (w > 0 ? from[w - 1] >> 63 : 0) |
-                  (w + 1 < words_ ? from[w + 1] << 63 : 0);
-    }
-    const int iy = static_cast<int>(r % ny);
-    const int it = static_cast<int>(r / ny);
-    for (int dt = -1; dt <= 1; ++dt)
-    {
-      const int t = (it + dt + spec_.nt) % spec_.nt;
-      for (int dy = -1; dy <= 1; ++dy)
+      for (Word bits = reached_[row * words_ + w]; bits != 0; bits &= bits - 1)
       {
-        const int y = iy + dy;
-        const std::size_t next = static_cast<std::size_t>(t) * ny + static_cast<std::size_t>(y);
-        if (y < 0 || y >= spec_.ny || next == r)
-        {
-          continue;  // a row's own runs never touch (a gap lies between them)
-        }
-        const Word* level = levelOf(next);
-        const Word* reached = reached_.data() + next * words_;
-        Word any = 0;
-        for (std::size_t w = 0; w < words_; ++w)
-        {
-          seeds[w] = spread[w] & level[w] & ~reached[w];
-          any |= seeds[w];
-        }
-        voxels += any != 0 ? fill(next, seeds.data()) : 0;
+        voxels.push_back(row * nx + 64 * w + static_cast<std::size_t>(__builtin_ctzll(bits)));
       }
     }
   }

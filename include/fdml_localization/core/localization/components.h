@@ -77,16 +77,10 @@ std::vector<std::size_t> componentSizes(const GridSpec& spec, const std::vector<
 /**
  * @brief Lifts to @p level + 1 (0 <= level <= 254) the voxels at exactly @p level outside its
  *        regional maxima (regionalMaxima()): those connected, through voxels at the level, to a
- *        voxel above it. @p above must list every voxel above the level with a neighbour at it
- *        (others do no harm).
- * @return the voxels lifted, in flood order
+ *        voxel above it. Flooded 64 voxels along x at a time (LevelMasks).
+ * @return the voxels lifted (ascending)
  */
-std::vector<std::size_t> liftNonMaximalPlateaus(const GridSpec& spec, std::vector<std::uint8_t>& count, int level,
-                                                const std::vector<std::size_t>& above);
-
-/// The voxels of @p voxels (same order) with a neighbour whose count is below @p level.
-std::vector<std::size_t> withNeighbourBelow(const GridSpec& spec, const std::vector<std::uint8_t>& count, int level,
-                                            const std::vector<std::size_t>& voxels);
+std::vector<std::size_t> liftNonMaximalPlateaus(const GridSpec& spec, std::vector<std::uint8_t>& count, int level);
 
 /**
  * @brief The regional maxima of the count field at exactly @p level: connected plateaus of

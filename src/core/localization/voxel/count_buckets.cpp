@@ -60,20 +60,14 @@ std::vector<VoxelCluster> ScreenedCount::maximaAt(int level, const BoxScreen& sc
   }
   if (level != next_level_)
   {
-    // The first level asked for (or one below a level skipped): every voxel above it.
-    above_.clear();
-    for (std::size_t v = 0; v < count_.size(); ++v)
-    {
-      if (count_[v] > level)
-      {
-        above_.push_back(v);
-      }
-    }
+    // The first level asked for (or one below a level skipped).
+    any_above_ = std::any_of(count_.begin(), count_.end(), [level](std::uint8_t c) { return c > level; });
   }
   next_level_ = level - 1;
   // The plateaus touching a voxel above the level are no maxima: lifted above it while the level
   // is screened (so they are not), then put back. (None at level 255: no count is above it.)
-  const std::vector<std::size_t> lower = liftNonMaximalPlateaus(spec_, count_, level, above_);
+  const std::vector<std::size_t> lower =
+      any_above_ ? liftNonMaximalPlateaus(spec_, count_, level) : std::vector<std::size_t>();
   // The voxels failing are lowered to level - 1: no pose of them explains `level` readings.
   std::vector<std::size_t> kept;
   for (const VoxelVerdict& v : screenLevel(spec_, count_, level, blocks_, screen))
@@ -84,10 +78,8 @@ std::vector<VoxelCluster> ScreenedCount::maximaAt(int level, const BoxScreen& sc
   {
     count_[v] = static_cast<std::uint8_t>(level);
   }
-  // The voxels left at the level never change again; those that may touch a lower one stay.
-  above_.insert(above_.end(), kept.begin(), kept.end());
-  above_.insert(above_.end(), lower.begin(), lower.end());
-  above_ = withNeighbourBelow(spec_, count_, level, above_);
+  // Those left at the level are above the next one.
+  any_above_ = any_above_ || !kept.empty();
   return regionalMaxima(spec_, count_, level, kept);
 }
 

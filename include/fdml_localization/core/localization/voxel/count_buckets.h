@@ -75,10 +75,9 @@ private:
   const GridSpec& spec_;
   std::vector<std::uint8_t> count_;  ///< the screened field (copy of the conservative one)
   const BlockMaxima& blocks_;        ///< of the conservative field
-  /// The voxels above the next level that may touch a voxel at it (the rest are surrounded by
-  /// voxels at least as high, which never change again).
-  std::vector<std::size_t> above_;
-  int next_level_ = -1;  ///< the level maximaAt() expects next (above_ is for it)
+  /// Whether some voxel lies above the next level (none: no plateau there is lifted).
+  bool any_above_ = false;
+  int next_level_ = -1;  ///< the level maximaAt() expects next (any_above_ is for it)
 };
 
 }  // namespace core

@@ -5,6 +5,7 @@
 #include "fdml_localization/core/localization/adaptive/leaf_clustering.h"
 #include "fdml_localization/core/localization/adaptive/leaf_search.h"
 #include "fdml_localization/core/localization/ranking.h"
+#include "fdml_localization/core/util/threads.h"
 
 #include <algorithm>
 #include <numeric>
@@ -32,6 +33,66 @@ constexpr long kProbeBoxTests = 100000;
 /// readings, 10,721 leaves reach 4 on a random 70-gon and 100,000 box tests never probed the
 /// truth's leaf (its centre explains 2, a sub-box's 4).
 constexpr long kProbeReadingTests = 1600000;
+/// A probe (probeLeaf()) made ahead of its turn, with the budget left when it was made.
+struct Probe
+{
+  bool reaches = true;
+  long used = 0;  ///< box tests
+  Candidate centre;
+};
+
+/// Probes (probeLeaf()) the @p open leaves at @p target in their order while kProbeBoxTests or kProbeReadingTests
+/// last, a leaf holding no sub-box reaching it losing a point of its bound. A probe is never cut short unless the
+/// budget runs out during it, so the probes are made threads-many at a time, each with the budget left before them,
+/// and taken in order: one whose tests fit in what the earlier ones left is what the serial loop makes; the one that
+/// does not is probed again with that. The same answer on any number of threads.
+void probeOpenLeaves(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
+                     int target, std::vector<OpenLeaf>& open)
+{
+  std::vector<std::size_t> at;
+  for (std::size_t i = 0; i < open.size(); ++i)
+  {
+    if (open[i].bound == target)
+    {
+      at.push_back(i);
+    }
+  }
+  const int threads = threadsFor(options.threads);
+  const std::size_t batch = 4 * static_cast<std::size_t>(threads);
+  long budget = testBudget(kProbeBoxTests, kProbeReadingTests, readings);
+  for (std::size_t first = 0; first < at.size() && budget > 0; first += batch)
+  {
+    const long n = static_cast<long>(std::min(batch, at.size() - first));
+    std::vector<Probe> probes(static_cast<std::size_t>(n));
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (n >= 2)
+    for (long j = 0; j < n; ++j)
+    {
+      Probe& p = probes[static_cast<std::size_t>(j)];
+      const OpenLeaf& o = open[at[first + static_cast<std::size_t>(j)]];
+      p.centre = o.centre;
+      long left = budget;
+      p.reaches = probeLeaf(map, o.leaf->box, readings, options, target, kScreenDepth, p.centre, left);
+      p.used = budget - left;
+    }
+    for (long j = 0; j < n && budget > 0; ++j)
+    {
+      Probe& p = probes[static_cast<std::size_t>(j)];
+      OpenLeaf& o = open[at[first + static_cast<std::size_t>(j)]];
+      if (p.used > budget)  // the budget runs out in this probe: made again with what is left
+      {
+        p.centre = o.centre;
+        p.reaches = probeLeaf(map, o.leaf->box, readings, options, target, kScreenDepth, p.centre, budget);
+      }
+      else
+      {
+        budget -= p.used;
+      }
+      o.centre = std::move(p.centre);
+      o.bound -= p.reaches ? 0 : 1;
+    }
+  }
+}
+
 /// Screens (screenLeaf()) the @p open leaves whose bound exceeds @p target (the answer then provably incomplete) while
 /// kScreenBoxTests last, the highest bounds first: their bound tightened, their centre the best of their deepest
 /// sub-boxes'. Box tests are cheap beside the verifications and refinements of a leaf's search, and most such leaves
@@ -53,12 +114,20 @@ void screenOpenLeaves(const MapRayCaster& map, const std::vector<Reading>& readi
   {
     screenedOut(map, readings, options, open[order[j]], budget);
   }
-  budget = testBudget(kProbeBoxTests, kProbeReadingTests, readings);
-  for (auto o = open.begin(); o != open.end() && budget > 0; ++o)
+  probeOpenLeaves(map, readings, options, target, open);
+}
+
+/// The centres of the @p open leaves listed in @p which verified, with their agreement at the leaf's scale
+/// (verifiedBox()), in parallel: each leaf's own, the same on any number of threads.
+void verifyCentres(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
+                   const std::vector<std::size_t>& which, std::vector<OpenLeaf>& open)
+{
+  const long n = static_cast<long>(which.size());
+#pragma omp parallel for schedule(dynamic, 64) num_threads(threadsFor(options.threads)) if (n >= 256)
+  for (long j = 0; j < n; ++j)
   {
-    const bool none =
-        o->bound == target && !probeLeaf(map, o->leaf->box, readings, options, target, kScreenDepth, o->centre, budget);
-    o->bound -= none ? 1 : 0;
+    OpenLeaf& o = open[which[static_cast<std::size_t>(j)]];
+    o.centre = verifiedBox(map, o.leaf->box, readings, options.agreement_tolerance, o.agreement);
   }
 }
 
@@ -149,6 +218,7 @@ std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<Leaf
   // Spread over all alike, the voxel engine's 147,000 voxels reaching 3 of 5 readings (turning
   // in the warehouse) skipped the truth's, one of the few reaching 5.
   std::vector<OpenLeaf> open;
+  std::vector<std::size_t> unverified;  // indices into open
   for (const std::size_t l : leavesToSearch(leaves, labels, target, kFillLeaves))
   {
     const LeafBox& leaf = leaves[l];
@@ -173,16 +243,14 @@ std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<Leaf
     // The continuum of one short of exact is its own place too: turning with 4 cones of 40 deg, the truth's leaf lay
     // 4.8 cm and 21 deg along that of the best candidate (6.5 mm), beyond its margins (verification seed 810).
     o.own = own || (accounted && rival->rms_residual >= kExactRms);
-    if (accounted && !o.own)
+    o.centre.inliers = -1;  // unset: verified below, or when searched in pass 1 where accounted for
+    if (!accounted || o.own)
     {
-      o.centre.inliers = -1;  // verified when searched in pass 1
-    }
-    else
-    {
-      o.centre = verifiedBox(map, leaf.box, readings, options.agreement_tolerance, o.agreement);
+      unverified.push_back(open.size());
     }
     open.push_back(std::move(o));
   }
+  verifyCentres(map, readings, options, unverified, open);
   screenOpenLeaves(map, readings, options, target, open);
   rankWithinRegions(regions, target, open);
   return open;

@@ -33,6 +33,7 @@ constexpr long kProbeBoxTests = 100000;
 /// readings, 10,721 leaves reach 4 on a random 70-gon and 100,000 box tests never probed the
 /// truth's leaf (its centre explains 2, a sub-box's 4).
 constexpr long kProbeReadingTests = 1600000;
+
 /// A probe (probeLeaf()) made ahead of its turn, with the budget left when it was made.
 struct Probe
 {
@@ -40,58 +41,6 @@ struct Probe
   long used = 0;  ///< box tests
   Candidate centre;
 };
-
-/// Probes (probeLeaf()) the @p open leaves at @p target in their order while kProbeBoxTests or kProbeReadingTests
-/// last, a leaf holding no sub-box reaching it losing a point of its bound. A probe is never cut short unless the
-/// budget runs out during it, so the probes are made threads-many at a time, each with the budget left before them,
-/// and taken in order: one whose tests fit in what the earlier ones left is what the serial loop makes; the one that
-/// does not is probed again with that. The same answer on any number of threads.
-void probeOpenLeaves(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
-                     int target, std::vector<OpenLeaf>& open)
-{
-  std::vector<std::size_t> at;
-  for (std::size_t i = 0; i < open.size(); ++i)
-  {
-    if (open[i].bound == target)
-    {
-      at.push_back(i);
-    }
-  }
-  const int threads = threadsFor(options.threads);
-  const std::size_t batch = 4 * static_cast<std::size_t>(threads);
-  long budget = testBudget(kProbeBoxTests, kProbeReadingTests, readings);
-  for (std::size_t first = 0; first < at.size() && budget > 0; first += batch)
-  {
-    const long n = static_cast<long>(std::min(batch, at.size() - first));
-    std::vector<Probe> probes(static_cast<std::size_t>(n));
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (n >= 2)
-    for (long j = 0; j < n; ++j)
-    {
-      Probe& p = probes[static_cast<std::size_t>(j)];
-      const OpenLeaf& o = open[at[first + static_cast<std::size_t>(j)]];
-      p.centre = o.centre;
-      long left = budget;
-      p.reaches = probeLeaf(map, o.leaf->box, readings, options, target, kScreenDepth, p.centre, left);
-      p.used = budget - left;
-    }
-    for (long j = 0; j < n && budget > 0; ++j)
-    {
-      Probe& p = probes[static_cast<std::size_t>(j)];
-      OpenLeaf& o = open[at[first + static_cast<std::size_t>(j)]];
-      if (p.used > budget)  // the budget runs out in this probe: made again with what is left
-      {
-        p.centre = o.centre;
-        p.reaches = probeLeaf(map, o.leaf->box, readings, options, target, kScreenDepth, p.centre, budget);
-      }
-      else
-      {
-        budget -= p.used;
-      }
-      o.centre = std::move(p.centre);
-      o.bound -= p.reaches ? 0 : 1;
-    }
-  }
-}
 
 /// Screens (screenLeaf()) the @p open leaves whose bound exceeds @p target (the answer then provably incomplete) while
 /// kScreenBoxTests last, the highest bounds first: their bound tightened, their centre the best of their deepest
@@ -114,7 +63,7 @@ void screenOpenLeaves(const MapRayCaster& map, const std::vector<Reading>& readi
   {
     screenedOut(map, readings, options, open[order[j]], budget);
   }
-  probeOpenLeaves(map, readings, options, target, open);
+  probeOpenLeaves(map, readings, options, target, testBudget(kProbeBoxTests, kProbeReadingTests, readings), open);
 }
 
 /// The centres of the @p open leaves listed in @p which verified, with their agreement at the leaf's scale
@@ -198,6 +147,55 @@ bool screenedOut(const MapRayCaster& map, const std::vector<Reading>& readings, 
   const bool out = !screenLeaf(map, o.leaf->box, readings, options, o.bound, kScreenDepth, o.centre, budget);
   o.bound -= out ? 1 : 0;
   return out;
+}
+
+// A probe is never cut short unless the budget runs out during it, so the probes are made a few per thread at a time,
+// each with the budget left before them, and taken in order: one whose tests fit in what the earlier ones left is what
+// the serial loop makes; the one that does not is probed again with that.
+void probeOpenLeaves(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
+                     int target, long budget, std::vector<OpenLeaf>& open)
+{
+  std::vector<std::size_t> at;
+  for (std::size_t i = 0; i < open.size(); ++i)
+  {
+    if (open[i].bound == target)
+    {
+      at.push_back(i);
+    }
+  }
+  const int threads = threadsFor(options.threads);
+  const std::size_t batch = 4 * static_cast<std::size_t>(threads);
+  for (std::size_t first = 0; first < at.size() && budget > 0; first += batch)
+  {
+    const long n = static_cast<long>(std::min(batch, at.size() - first));
+    std::vector<Probe> probes(static_cast<std::size_t>(n));
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (n >= 2)
+    for (long j = 0; j < n; ++j)
+    {
+      Probe& p = probes[static_cast<std::size_t>(j)];
+      const OpenLeaf& o = open[at[first + static_cast<std::size_t>(j)]];
+      p.centre = o.centre;
+      long left = budget;
+      p.reaches = probeLeaf(map, o.leaf->box, readings, options, target, kScreenDepth, p.centre, left);
+      p.used = budget - left;
+    }
+    for (long j = 0; j < n && budget > 0; ++j)
+    {
+      Probe& p = probes[static_cast<std::size_t>(j)];
+      OpenLeaf& o = open[at[first + static_cast<std::size_t>(j)]];
+      if (p.used > budget)  // the budget runs out in this probe: made again with what is left
+      {
+        p.centre = o.centre;
+        p.reaches = probeLeaf(map, o.leaf->box, readings, options, target, kScreenDepth, p.centre, budget);
+      }
+      else
+      {
+        budget -= p.used;
+      }
+      o.centre = std::move(p.centre);
+      o.bound -= p.reaches ? 0 : 1;
+    }
+  }
 }
 
 std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<LeafBox>& leaves, int target,

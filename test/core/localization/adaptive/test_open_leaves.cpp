@@ -144,6 +144,59 @@ TEST_F(OpenLeavesTest, LeavesAgreeingWithTheTargetComeBeforeTheNextRankOfOtherRe
   EXPECT_FALSE(inA(order[4]) || inA(order[5]) || inA(order[6]));
 }
 
+TEST_F(OpenLeavesTest, ProbesInParallelAreTheSerialLoopsOnAnyNumberOfThreads)
+{
+  // 600 leaves of 1 m and 0.8 rad around the truth, at the target, and the serial loop: each
+  // leaf probed in turn while the budget lasts (the probe overrunning it cut short).
+  std::mt19937_64 rng(21);
+  std::uniform_real_distribution<double> near(-0.8, 0.8);
+  leaves.clear();
+  for (int j = 0; j < 600; ++j)
+  {
+    LeafBox leaf = leafAround(Pose2(q.x + near(rng), q.y + near(rng), q.theta + near(rng)), 6);
+    leaf.box = PoseBox{ leaf.box.x0 - 0.475, leaf.box.x1 + 0.475, leaf.box.y0 - 0.475,
+                        leaf.box.y1 + 0.475, leaf.box.t0 - 0.375, leaf.box.t1 + 0.375 };
+    leaves.push_back(leaf);
+  }
+  std::vector<OpenLeaf> start;
+  for (const LeafBox& leaf : leaves)
+  {
+    OpenLeaf o{ &leaf, Candidate(), 0, 0, 6, Candidate(), false, false, BoxAgreement() };
+    o.centre = verifiedBox(*map, leaf.box, readings, LocalizerOptions().agreement_tolerance, o.agreement);
+    start.push_back(o);
+  }
+  for (long budget : { 1L, 37L, 400L, 3000L, 1000000L })
+  {
+    std::vector<OpenLeaf> serial = start;
+    long left = budget;
+    std::size_t lowered = 0;
+    for (OpenLeaf& o : serial)
+    {
+      if (left <= 0)
+      {
+        break;
+      }
+      o.bound -= probeLeaf(*map, o.leaf->box, readings, LocalizerOptions(), 6, 3, o.centre, left) ? 0 : 1;
+      lowered += o.bound < 6 ? 1 : 0;
+    }
+    EXPECT_GT(lowered + (budget < 1000 ? 1 : 0), 0u) << "budget " << budget;
+    for (int threads : { 1, 2, 3 })
+    {
+      LocalizerOptions options;
+      options.threads = threads;
+      std::vector<OpenLeaf> parallel = start;
+      probeOpenLeaves(*map, readings, options, 6, budget, parallel);
+      for (std::size_t i = 0; i < parallel.size(); ++i)
+      {
+        ASSERT_EQ(parallel[i].bound, serial[i].bound) << "budget " << budget << " threads " << threads << " leaf " << i;
+        ASSERT_EQ(parallel[i].centre.inliers, serial[i].centre.inliers) << "budget " << budget << " leaf " << i;
+        ASSERT_EQ(parallel[i].centre.pose.x, serial[i].centre.pose.x) << "budget " << budget << " leaf " << i;
+        ASSERT_EQ(parallel[i].centre.pose.theta, serial[i].centre.pose.theta) << "budget " << budget << " leaf " << i;
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace core
 }  // namespace fdml_localization

@@ -73,6 +73,13 @@ std::vector<OpenLeaf> openLeaves(const MapRayCaster& map, const std::vector<Leaf
                                  const std::vector<Candidate>& candidates, const LocalizerOptions& options,
                                  double settled);
 
+/// Probes (probeLeaf()) the @p open leaves whose bound is @p target, in their order, while @p budget box tests last: a
+/// leaf holding no sub-box reaching the target loses a point of its bound, and the centre of one that does becomes that
+/// sub-box's where better. The probes run in parallel (LocalizerOptions::threads), with the same answer as one after
+/// the other on any number of threads.
+void probeOpenLeaves(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
+                     int target, long budget, std::vector<OpenLeaf>& open);
+
 /// The order the open leaves are searched in: first those whose bound exceeds @p target, the
 /// highest bounds first (a place there beats the best candidate and raises the target), then all
 /// of them in openLeaves()' round robin.

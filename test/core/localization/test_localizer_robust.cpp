@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <memory>
 #include <numeric>
 
 namespace fdml_localization
@@ -183,6 +184,43 @@ TEST_P(LocalizerRobust, FourOfTenReadingsHitObstacles)
   EXPECT_GE(fixed_found, voxel ? 95 : 90);
   EXPECT_GE(auto_found, voxel ? 90 : 85);
   EXPECT_LT(baseline_found, 10);
+}
+
+TEST_P(LocalizerRobust, TheAnswerIsTheSameOnAnyNumberOfThreads)
+{
+  // The parallel stages (preimages, counts, screens, seeds, the fill's probes and leaf searches
+  // taken ahead of their turn) give the serial answer: same candidates, bit for bit.
+  const auto map = test::loadMap("maps/apartment.poly");
+  std::vector<std::unique_ptr<Localizer>> localizers;
+  for (int threads : { 1, 2, 3 })
+  {
+    LocalizerOptions options;
+    options.engine = GetParam();
+    options.resolution = 64;
+    options.threads = threads;
+    localizers.push_back(std::make_unique<Localizer>(map, options));
+  }
+  std::mt19937_64 rng(23);
+  for (int trial = 0; trial < 8; ++trial)
+  {
+    const OutlierTrial t = shortenedReadings(*map, rng);
+    const Result serial = localizers.front()->localize(t.readings);
+    ASSERT_FALSE(serial.candidates.empty()) << "trial " << trial;
+    for (std::size_t l = 1; l < localizers.size(); ++l)
+    {
+      const Result r = localizers[l]->localize(t.readings);
+      ASSERT_EQ(r.candidates.size(), serial.candidates.size()) << "trial " << trial << " threads " << l + 1;
+      for (std::size_t c = 0; c < r.candidates.size(); ++c)
+      {
+        EXPECT_EQ(r.candidates[c].pose.x, serial.candidates[c].pose.x) << "trial " << trial << " candidate " << c;
+        EXPECT_EQ(r.candidates[c].pose.y, serial.candidates[c].pose.y) << "trial " << trial << " candidate " << c;
+        EXPECT_EQ(r.candidates[c].pose.theta, serial.candidates[c].pose.theta) << "trial " << trial;
+        EXPECT_EQ(r.candidates[c].inliers, serial.candidates[c].inliers) << "trial " << trial;
+        EXPECT_EQ(r.candidates[c].rms_residual, serial.candidates[c].rms_residual) << "trial " << trial;
+      }
+      EXPECT_EQ(r.certificate.max_consensus_bound, serial.certificate.max_consensus_bound) << "trial " << trial;
+    }
+  }
 }
 
 TEST_P(LocalizerRobust, PaperModeFindsComponentCentresWithoutPolish)

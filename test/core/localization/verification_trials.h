@@ -56,24 +56,24 @@ inline std::vector<std::shared_ptr<const MapRayCaster>> smallMaps()
   return { test::loadMap("maps/l_room.poly"), test::lRoomMap(), test::loadMap("maps/square_room.poly") };
 }
 
-/// The options of a verification trial: @p engine at @p resolution, one thread.
-inline LocalizerOptions trialOptions(Engine engine, int resolution = 64)
+/// The options of a verification trial: @p engine at @p resolution, on @p threads threads.
+inline LocalizerOptions trialOptions(Engine engine, int resolution = 64, int threads = 1)
 {
   LocalizerOptions options;
   options.engine = engine;
   options.resolution = resolution;
-  options.threads = 1;
+  options.threads = threads;
   return options;
 }
 
 /// One localizer with trialOptions() per map of @p maps.
-inline std::vector<std::unique_ptr<Localizer>>
-localizersFor(const std::vector<std::shared_ptr<const MapRayCaster>>& maps, Engine engine, int resolution = 64)
+inline std::vector<std::unique_ptr<Localizer>> localizersFor(
+    const std::vector<std::shared_ptr<const MapRayCaster>>& maps, Engine engine, int resolution = 64, int threads = 1)
 {
   std::vector<std::unique_ptr<Localizer>> localizers;
   for (const auto& map : maps)
   {
-    localizers.push_back(std::make_unique<Localizer>(map, trialOptions(engine, resolution)));
+    localizers.push_back(std::make_unique<Localizer>(map, trialOptions(engine, resolution, threads)));
   }
   return localizers;
 }

@@ -4,6 +4,7 @@
 // certificate was contradicted.
 //   verify_localization [--trials N] [--minutes M] [--seed S] [--resolution N] [--map FILE.poly[:SCALE] ...]
 //                       [--random-maps N] [--buildings N] [--rooms N] [--scale S] [--k MIN:MAX] [--fov DEG]
+//                       [--threads J]
 // --map (repeatable) verifies on those polygon maps (scaled about the origin by SCALE), --random-maps
 // on N random star-shaped 70-gons (mean radius 2 m, radii 1 to 3 m), --buildings on N generated
 // 12 x 9 m buildings (1.2 m corridors, 3 m rooms, 10 cm walls), --rooms on N furnished rooms (8 x 6 m
@@ -12,7 +13,8 @@
 // the origin. Without any of them, the three small built-in maps. --k draws the readings per trial
 // from [MIN, MAX] (default 4:30, within [3, 100]) to hunt where a search is hardest (few readings);
 // at the default the trials of a seed are those of earlier builds. --fov gives every reading a cone
-// of that full field of view [deg] (0 to 180): the same poses, cone ranges.
+// of that full field of view [deg] (0 to 180): the same poses, cone ranges. --threads J (1 to 64,
+// default 1) runs each localization on J threads: the answers, and so the figures, are those of one.
 #include "generated_maps.h"
 #include "verification_checks.h"
 
@@ -40,6 +42,7 @@ struct Args
   double minutes = 15.0;
   unsigned long seed = 16;
   int resolution = 64;
+  int threads = 1;
   std::vector<std::string> maps;  ///< FILE.poly[:SCALE]; none of these three: verification::smallMaps()
   int random_maps = 0;
   int buildings = 0;
@@ -123,6 +126,10 @@ bool setNumericFlag(const char* flag, double value, Args& args)
   else if (std::strcmp(flag, "--resolution") == 0 && value >= 16 && value <= 1024)
   {
     args.resolution = static_cast<int>(value);
+  }
+  else if (std::strcmp(flag, "--threads") == 0 && value >= 1 && value <= 64)
+  {
+    args.threads = static_cast<int>(value);
   }
   else if (std::strcmp(flag, "--random-maps") == 0 && value <= kMaxGenerated)
   {
@@ -277,7 +284,7 @@ int main(int argc, char** argv)
   {
     std::cerr << "usage: verify_localization [--trials N] [--minutes M] [--seed S] [--resolution N] "
                  "[--map FILE.poly[:SCALE] ...] [--random-maps N] [--buildings N] [--rooms N] [--scale S] "
-                 "[--k MIN:MAX] [--fov DEG]\n";
+                 "[--k MIN:MAX] [--fov DEG] [--threads J]\n";
     return 2;
   }
   std::vector<std::shared_ptr<const MapRayCaster>> maps;
@@ -287,8 +294,8 @@ int main(int argc, char** argv)
     return 2;
   }
   const std::vector<std::unique_ptr<Localizer>> localizers[2] = {
-    verification::localizersFor(maps, Engine::Voxel, args.resolution),
-    verification::localizersFor(maps, Engine::Adaptive, args.resolution)
+    verification::localizersFor(maps, Engine::Voxel, args.resolution, args.threads),
+    verification::localizersFor(maps, Engine::Adaptive, args.resolution, args.threads)
   };
   std::mt19937_64 rng(args.seed);
   verification::Figures total[2];

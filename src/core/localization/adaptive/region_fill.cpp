@@ -5,6 +5,7 @@
 #include "fdml_localization/core/localization/adaptive/open_leaves.h"
 #include "fdml_localization/core/localization/adaptive/leaf_search.h"
 #include "fdml_localization/core/localization/ranking.h"
+#include "fdml_localization/core/util/threads.h"
 
 #include <algorithm>
 #include <cmath>
@@ -127,59 +128,174 @@ bool leftToFound(Accounting& found, const PoseBox& box, int pass, int target, do
   return false;
 }
 
-/// One pass over the open leaves in @p order. Pass 0 leaves for pass 1 (while the budget lasts) the leaves of
-/// regions holding a place that are not promising and those on the continuum of a candidate that accountsFor() them:
-/// mostly they hold those places again. A leaf is promising when its centre explains within kPromisingSlack readings
-/// of the target, or the target within the bands of the leaf's own scale (its agreement: verification seed 811, the
-/// truth's leaf explained 1 of 6 readings at its centre and all 6 in their bands).
+/// What fillPass() does at a leaf.
+enum class Turn
+{
+  kStop,    ///< the pass ends (its budget spent)
+  kSkip,    ///< the leaf is passed over
+  kSearch,  ///< the leaf is screened where its bound exceeds the target (beyond), then searched
+};
+
+/// The turn of leaf @p i (@p o) in @p pass as @p state stands. Pass 0 leaves for pass 1 (while the budget lasts) the
+/// leaves of regions holding a place that are not promising and those on the continuum of a candidate that
+/// accountsFor() them: mostly they hold those places again. A leaf is promising when its centre explains within
+/// kPromisingSlack readings of the target, or the target within the bands of the leaf's own scale (its agreement:
+/// verification seed 811, the truth's leaf explained 1 of 6 readings at its centre and all 6 in their bands). A leaf
+/// whose bound exceeds the target (@p beyond) may hold a better place: it is searched for one. @p rival is set to the
+/// candidate a place found must beat (inliers -1: none).
+Turn turnOf(const OpenLeaf& o, std::size_t i, int pass, FillState& state, bool& beyond, Candidate& rival)
+{
+  beyond = o.bound > state.target;
+  const bool promising = beyond || o.agreement.within >= state.target ||
+                         (o.centre.inliers >= 0 && netConsensus(o.centre) >= state.target - kPromisingSlack);
+  const bool deferred = !beyond && (accountsFor(o.rival, state.target, state.settled) ||
+                                    (state.placed[static_cast<std::size_t>(o.region)] && !promising));
+  if (state.budget + (beyond ? kBeyondBoxTests : 0) <= 0 && (pass != 0 || state.tried >= kFillTries))
+  {
+    return Turn::kStop;
+  }
+  rival = o.rival;
+  const bool skip = state.searched[i] || o.bound < state.target || (pass == 0 && deferred) ||
+                    (pass == kOwnPlacePass && !o.own) ||
+                    (!beyond && leftToFound(state.found, o.leaf->box, pass, state.target, state.settled, rival));
+  return skip ? Turn::kSkip : Turn::kSearch;
+}
+
+/// A leaf's screen and search for @p goal readings, made on a copy of it: neither depends on the budget (they are never
+/// cut short), so a search made ahead of its turn is the one its turn makes for the same goal.
+struct LeafTurn
+{
+  int goal = -1;
+  bool beyond = false;
+  OpenLeaf leaf;     ///< the leaf after its screen and its centre's verification
+  bool out = false;  ///< screened out: not searched
+  Candidate place;
+  long used = 0;  ///< box tests
+};
+
+LeafTurn takeTurn(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
+                  const RefinementSettings& settings, const OpenLeaf& o, bool beyond, int goal)
+{
+  LeafTurn t{ goal, beyond, o, false, Candidate(), 0 };
+  long budget = 0;
+  t.out = beyond && screenedOut(map, readings, options, t.leaf, budget);
+  if (!t.out)
+  {
+    if (t.leaf.centre.inliers < 0)
+    {
+      t.leaf.centre = verifiedCandidate(map, t.leaf.leaf->box.centre(), readings, options.agreement_tolerance);
+    }
+    t.place = placeInLeaf(map, readings, options, settings, t.leaf, goal, budget);
+  }
+  t.used = -budget;
+  return t;
+}
+
+/// Leaf @p i's turn @p t taken: its screen and search counted, and the place found admitted where it reaches the
+/// target and beats @p rival.
+void commitTurn(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
+                const RefinementSettings& settings, OpenLeaf& o, std::size_t i, LeafTurn t, const Candidate& rival,
+                FillState& state)
+{
+  o = std::move(t.leaf);
+  state.budget -= t.used;
+  if (t.out)
+  {
+    return;
+  }
+  state.searched[i] = 1;
+  ++state.tried;
+  Candidate& place = t.place;
+  if (netConsensus(place) >= state.target)
+  {
+    settleAlongContinua(map, readings, settings, place);  // before it meets its rival (placeInLeaf())
+  }
+  if (netConsensus(place) >= state.target && (rival.inliers < 0 || betterCandidate(place, rival)))
+  {
+    if (netConsensus(place) > state.target)
+    {
+      state.found.clear();  // the places found so far fall short of it
+    }
+    state.target = netConsensus(place);
+    state.placed[static_cast<std::size_t>(o.region)] = 1;
+    admit(options, settings, o.leaf->box, std::move(place), state);
+  }
+}
+
+/// The positions in @p order from @p from on of the next @p batch leaves the pass searches as @p state stands, and
+/// their turns taken ahead, in parallel.
+std::vector<std::pair<std::size_t, LeafTurn>> turnsAhead(const MapRayCaster& map, const std::vector<Reading>& readings,
+                                                         const LocalizerOptions& options,
+                                                         const RefinementSettings& settings,
+                                                         const std::vector<OpenLeaf>& open,
+                                                         const std::vector<std::size_t>& order, std::size_t from,
+                                                         std::size_t batch, int pass, FillState& state)
+{
+  std::vector<std::pair<std::size_t, LeafTurn>> ahead;
+  bool beyond = false;
+  Candidate rival;
+  for (std::size_t at = from; at < order.size() && ahead.size() < batch; ++at)
+  {
+    const Turn turn = turnOf(open[order[at]], order[at], pass, state, beyond, rival);
+    if (turn == Turn::kStop)
+    {
+      break;
+    }
+    if (turn == Turn::kSearch)
+    {
+      ahead.emplace_back(at, LeafTurn{ beyond ? state.target + 1 : state.target, beyond, OpenLeaf(), false, {}, 0 });
+    }
+  }
+  const long n = static_cast<long>(ahead.size());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threadsFor(options.threads)) if (n >= 2)
+  for (long j = 0; j < n; ++j)
+  {
+    auto& [at, t] = ahead[static_cast<std::size_t>(j)];
+    t = takeTurn(map, readings, options, settings, open[order[at]], t.beyond, t.goal);
+  }
+  return ahead;
+}
+
+/// One pass over the open leaves in @p order (turnOf()). The turns are taken a few per thread ahead (turnsAhead()),
+/// then in order as the state then stands: a turn taken ahead for the goal its turn has is that turn, and one whose
+/// goal changed (a place found raised the target) is taken again; the same answer as one leaf after the other.
 void fillPass(const MapRayCaster& map, const std::vector<Reading>& readings, const LocalizerOptions& options,
               const RefinementSettings& settings, std::vector<OpenLeaf>& open, const std::vector<std::size_t>& order,
               int pass, FillState& state)
 {
-  for (const std::size_t i : order)
+  const int threads = threadsFor(options.threads);
+  const std::size_t batch = threads > 1 ? 2 * static_cast<std::size_t>(threads) : 1;
+  for (std::size_t at = 0; at < order.size();)
   {
-    OpenLeaf& o = open[i];
-    // A leaf whose bound exceeds the target may hold a better place: it is searched for one.
-    const bool beyond = o.bound > state.target;
-    const bool promising = beyond || o.agreement.within >= state.target ||
-                           (o.centre.inliers >= 0 && netConsensus(o.centre) >= state.target - kPromisingSlack);
-    const bool deferred = !beyond && (accountsFor(o.rival, state.target, state.settled) ||
-                                      (state.placed[static_cast<std::size_t>(o.region)] && !promising));
-    if (state.budget + (beyond ? kBeyondBoxTests : 0) <= 0 && (pass != 0 || state.tried >= kFillTries))
+    std::vector<std::pair<std::size_t, LeafTurn>> ahead =
+        turnsAhead(map, readings, options, settings, open, order, at, batch, pass, state);
+    const std::size_t end = ahead.empty() ? order.size() : ahead.back().first + 1;
+    std::vector<std::size_t> taken;  // leaves whose turn this batch took: a leaf stands twice in order
+    for (auto next = ahead.begin(); at < end; ++at)
     {
-      return;
-    }
-    Candidate rival = o.rival;
-    if (state.searched[i] || o.bound < state.target || (pass == 0 && deferred) || (pass == kOwnPlacePass && !o.own) ||
-        (!beyond && leftToFound(state.found, o.leaf->box, pass, state.target, state.settled, rival)))
-    {
-      continue;
-    }
-    if (beyond && screenedOut(map, readings, options, o, state.budget))
-    {
-      continue;
-    }
-    state.searched[i] = 1;
-    ++state.tried;
-    if (o.centre.inliers < 0)
-    {
-      o.centre = verifiedCandidate(map, o.leaf->box.centre(), readings, options.agreement_tolerance);
-    }
-    Candidate place =
-        placeInLeaf(map, readings, options, settings, o, beyond ? state.target + 1 : state.target, state.budget);
-    if (netConsensus(place) >= state.target)
-    {
-      settleAlongContinua(map, readings, settings, place);  // before it meets its rival (placeInLeaf())
-    }
-    if (netConsensus(place) >= state.target && (rival.inliers < 0 || betterCandidate(place, rival)))
-    {
-      if (netConsensus(place) > state.target)
+      const std::size_t i = order[at];
+      bool beyond = false;
+      Candidate rival;
+      const Turn turn = turnOf(open[i], i, pass, state, beyond, rival);
+      if (turn == Turn::kStop)
       {
-        state.found.clear();  // the places found so far fall short of it
+        return;
       }
-      state.target = netConsensus(place);
-      state.placed[static_cast<std::size_t>(o.region)] = 1;
-      admit(options, settings, o.leaf->box, std::move(place), state);
+      while (next != ahead.end() && next->first < at)
+      {
+        ++next;
+      }
+      if (turn == Turn::kSkip)
+      {
+        continue;
+      }
+      const int goal = beyond ? state.target + 1 : state.target;
+      const bool made = next != ahead.end() && next->first == at && next->second.goal == goal &&
+                        next->second.beyond == beyond && std::find(taken.begin(), taken.end(), i) == taken.end();
+      taken.push_back(i);
+      commitTurn(map, readings, options, settings, open[i], i,
+                 made ? std::move(next->second) : takeTurn(map, readings, options, settings, open[i], beyond, goal),
+                 rival, state);
     }
   }
 }

@@ -97,6 +97,53 @@ UninitialisedVector<std::uint16_t> positionWindows(const UninitialisedVector<flo
   }
   return result;
 }
+/// Windows of at most this many heading cells are combined row by row (shortWindows()).
+constexpr int kShortWindow = 16;
+
+/// positionWindows() of alongTheta() for a window of @p m <= kShortWindow heading cells, without
+/// the array between them: each padded row's cells combined over the m heading slices (in order)
+/// as it is needed (rays' windows are 2 cells).
+UninitialisedVector<std::uint16_t> shortWindows(const std::vector<float>& src, const GridSpec& spec, int m,
+                                                bool theta_min, bool lower, const RangeSteps& steps)
+{
+  const std::size_t pnx = static_cast<std::size_t>(spec.nx) + 1;
+  const std::size_t pslice = pnx * (static_cast<std::size_t>(spec.ny) + 1);
+  UninitialisedVector<std::uint16_t> result(spec.voxelCount());  // every entry written below
+#pragma omp parallel
+  {
+    std::vector<float> near(pnx);
+    std::vector<float> far(pnx);
+    const auto combine = [&](int t, std::size_t row, std::vector<float>& out) {
+      const float* first = src.data() + static_cast<std::size_t>(t) * pslice + row * pnx;
+      std::copy_n(first, pnx, out.begin());
+      for (int k = 1; k < m; ++k)
+      {
+        const float* in = src.data() + static_cast<std::size_t>((t + k) % spec.nt) * pslice + row * pnx;
+        for (std::size_t c = 0; c < pnx; ++c)
+        {
+          out[c] = theta_min ? std::min(out[c], in[c]) : std::max(out[c], in[c]);
+        }
+      }
+    };
+#pragma omp for schedule(static)
+    for (int t = 0; t < spec.nt; ++t)
+    {
+      combine(t, 0, far);
+      for (int wy = 0; wy < spec.ny; ++wy)
+      {
+        near.swap(far);
+        combine(t, static_cast<std::size_t>(wy) + 1, far);
+        std::uint16_t* o = result.data() + spec.index(0, wy, t);
+        for (int wx = 0; wx < spec.nx; ++wx)
+        {
+          o[wx] = lower ? steps.down(std::min({ near[wx], near[wx + 1], far[wx], far[wx + 1] })) :
+                          steps.up(std::max({ near[wx], near[wx + 1], far[wx], far[wx + 1] }));
+        }
+      }
+    }
+  }
+  return result;
+}
 }  // namespace
 
 BoundWindows::BoundWindows(CellBounds cells)
@@ -109,7 +156,14 @@ void BoundWindows::require(Kind kind, int m)
   if (arrays_.count(key) == 0)
   {
     const bool lower = kind == Kind::Lower;
-    alongTheta(lower ? cells_.lower() : cells_.upper(), cells_.spec().nt, m, kind != Kind::UpperMax, along_);
+    const std::vector<float>& bounds = lower ? cells_.lower() : cells_.upper();
+    if (std::min(m, cells_.spec().nt) <= kShortWindow)
+    {
+      arrays_.emplace(key, shortWindows(bounds, cells_.spec(), std::max(1, std::min(m, cells_.spec().nt)),
+                                        kind != Kind::UpperMax, lower, steps_));
+      return;
+    }
+    alongTheta(bounds, cells_.spec().nt, m, kind != Kind::UpperMax, along_);
     arrays_.emplace(key, positionWindows(along_, cells_.spec(), lower, steps_));
   }
 }

@@ -39,8 +39,9 @@ public:
   std::size_t componentCount(const std::vector<std::size_t>& voxels, std::size_t& holding);
 
   /**
-   * @brief Floods the components holding a neighbour (26, periodic in theta) of a voxel of
-   *        @p source, a mask of the same grid: every voxel of this mask connected to @p source.
+   * @brief Floods the components holding a voxel of @p source (a mask of the same grid) or one
+   *        of its neighbours (26, periodic in theta): every voxel of this mask connected to
+   *        @p source.
    * @return the voxels this call adds to the flooded ones
    */
   std::size_t floodNeighboursOf(LevelMasks& source);

@@ -72,8 +72,19 @@ void alongTheta(const std::vector<float>& src, int nt, int m, bool theta_min, Un
   }
 }
 
-/// Min (lower) or max over 2 x 2 padded cells: window (wx, wy) = cells (wx .. wx + 1, wy .. wy + 1),
-/// in @p steps (lower bounds rounded down, upper ones up).
+/// One row of windows: entry wx the min (lower) or max of padded cells wx and wx + 1 of rows @p r0
+/// and @p r1 (heading-combined), in @p steps (lower bounds rounded down, upper ones up).
+void windowRow(const float* r0, const float* r1, int nx, bool lower, const RangeSteps& steps, std::uint16_t* o)
+{
+  for (int wx = 0; wx < nx; ++wx)
+  {
+    o[wx] = lower ? steps.down(std::min({ r0[wx], r0[wx + 1], r1[wx], r1[wx + 1] })) :
+                    steps.up(std::max({ r0[wx], r0[wx + 1], r1[wx], r1[wx + 1] }));
+  }
+}
+
+/// Min (lower) or max over 2 x 2 padded cells: window (wx, wy) = cells (wx .. wx + 1, wy .. wy + 1)
+/// (windowRow()).
 UninitialisedVector<std::uint16_t> positionWindows(const UninitialisedVector<float>& along, const GridSpec& spec,
                                                    bool lower, const RangeSteps& steps)
 {
@@ -86,13 +97,7 @@ UninitialisedVector<std::uint16_t> positionWindows(const UninitialisedVector<flo
     for (int wy = 0; wy < spec.ny; ++wy)
     {
       const float* r0 = along.data() + t * pslice + static_cast<std::size_t>(wy) * pnx;
-      const float* r1 = r0 + pnx;
-      std::uint16_t* o = result.data() + spec.index(0, wy, t);
-      for (int wx = 0; wx < spec.nx; ++wx)
-      {
-        o[wx] = lower ? steps.down(std::min({ r0[wx], r0[wx + 1], r1[wx], r1[wx + 1] })) :
-                        steps.up(std::max({ r0[wx], r0[wx + 1], r1[wx], r1[wx + 1] }));
-      }
+      windowRow(r0, r0 + pnx, spec.nx, lower, steps, result.data() + spec.index(0, wy, t));
     }
   }
   return result;
@@ -133,12 +138,7 @@ UninitialisedVector<std::uint16_t> shortWindows(const std::vector<float>& src, c
       {
         near.swap(far);
         combine(t, static_cast<std::size_t>(wy) + 1, far);
-        std::uint16_t* o = result.data() + spec.index(0, wy, t);
-        for (int wx = 0; wx < spec.nx; ++wx)
-        {
-          o[wx] = lower ? steps.down(std::min({ near[wx], near[wx + 1], far[wx], far[wx + 1] })) :
-                          steps.up(std::max({ near[wx], near[wx + 1], far[wx], far[wx + 1] }));
-        }
+        windowRow(near.data(), far.data(), spec.nx, lower, steps, result.data() + spec.index(0, wy, t));
       }
     }
   }

@@ -141,11 +141,12 @@ enum class Turn
 /// accountsFor() them: mostly they hold those places again. A leaf is promising when its centre explains within
 /// kPromisingSlack readings of the target, or the target within the bands of the leaf's own scale (its agreement:
 /// verification seed 811, the truth's leaf explained 1 of 6 readings at its centre and all 6 in their bands). A leaf
-/// whose bound exceeds the target (@p beyond) may hold a better place: it is searched for one. @p rival is set to the
-/// candidate a place found must beat (inliers -1: none).
-Turn turnOf(const OpenLeaf& o, std::size_t i, int pass, FillState& state, bool& beyond, Candidate& rival)
+/// whose bound exceeds the target (@p beyond) may hold a better place: it is searched for one (@p goal: one reading
+/// more than the target; else the target). @p rival is set to the candidate a place found must beat (inliers -1: none).
+Turn turnOf(const OpenLeaf& o, std::size_t i, int pass, FillState& state, bool& beyond, int& goal, Candidate& rival)
 {
   beyond = o.bound > state.target;
+  goal = beyond ? state.target + 1 : state.target;
   const bool promising = beyond || o.agreement.within >= state.target ||
                          (o.centre.inliers >= 0 && netConsensus(o.centre) >= state.target - kPromisingSlack);
   const bool deferred = !beyond && (accountsFor(o.rival, state.target, state.settled) ||
@@ -233,17 +234,18 @@ std::vector<std::pair<std::size_t, LeafTurn>> turnsAhead(const MapRayCaster& map
 {
   std::vector<std::pair<std::size_t, LeafTurn>> ahead;
   bool beyond = false;
+  int goal = 0;
   Candidate rival;
   for (std::size_t at = from; at < order.size() && ahead.size() < batch; ++at)
   {
-    const Turn turn = turnOf(open[order[at]], order[at], pass, state, beyond, rival);
+    const Turn turn = turnOf(open[order[at]], order[at], pass, state, beyond, goal, rival);
     if (turn == Turn::kStop)
     {
       break;
     }
     if (turn == Turn::kSearch)
     {
-      ahead.emplace_back(at, LeafTurn{ beyond ? state.target + 1 : state.target, beyond, OpenLeaf(), false, {}, 0 });
+      ahead.emplace_back(at, LeafTurn{ goal, beyond, OpenLeaf(), false, {}, 0 });
     }
   }
   const long n = static_cast<long>(ahead.size());
@@ -275,8 +277,9 @@ void fillPass(const MapRayCaster& map, const std::vector<Reading>& readings, con
     {
       const std::size_t i = order[at];
       bool beyond = false;
+      int goal = 0;
       Candidate rival;
-      const Turn turn = turnOf(open[i], i, pass, state, beyond, rival);
+      const Turn turn = turnOf(open[i], i, pass, state, beyond, goal, rival);
       if (turn == Turn::kStop)
       {
         return;
@@ -289,7 +292,6 @@ void fillPass(const MapRayCaster& map, const std::vector<Reading>& readings, con
       {
         continue;
       }
-      const int goal = beyond ? state.target + 1 : state.target;
       const bool made = next != ahead.end() && next->first == at && next->second.goal == goal &&
                         next->second.beyond == beyond && std::find(taken.begin(), taken.end(), i) == taken.end();
       taken.push_back(i);
